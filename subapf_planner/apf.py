@@ -1,0 +1,47 @@
+"""The artificial potential field step (paper eq. 23) from a point to its raw next move point."""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from .config import PlannerConfig
+from .potentials import attractive_gradient, repulsive_field
+
+#: Planner method -> repulsion kind of potentials.py.
+REPULSION_OF_METHOD = {
+    'subharmonic_sampling': 'subharmonic',
+    'subharmonic': 'subharmonic',
+    'traditional': 'traditional',
+    'harmonic': 'harmonic',
+}
+
+
+def apf_force(points: ArrayLike, goal: ArrayLike, obstacles: ArrayLike,
+              cfg: PlannerConfig) -> NDArray[np.float64]:
+    """F = -grad(phi_att + phi_rep) at each point, shape (n, 2).
+
+    The total potential is eq. (23) with the signs of NOTES.md section 1:
+    ``phi = phi_att(r_goal) + sum_i phi_rep(r_i)``, phi_rep per ``cfg.method``.
+    """
+    kind = REPULSION_OF_METHOD[cfg.method]
+    p = np.atleast_2d(np.asarray(points, float))
+    _, grad_rep = repulsive_field(kind, p, obstacles, cfg.repulsion_gain, cfg.k,
+                                  nearest_only=cfg.repulsion_mode == 'nearest',
+                                  influence=cfg.influence_distance)
+    grad_att = attractive_gradient(cfg.attraction, p, goal, cfg.attraction_gain)
+    return -(grad_att + grad_rep)
+
+
+def apf_step(points: ArrayLike, goal: ArrayLike, obstacles: ArrayLike,
+             cfg: PlannerConfig) -> NDArray[np.float64]:
+    """Raw next move point(s): ``p + eta * F``, the step clipped to ``max_step`` [m]
+    and to the distance to the goal (the step never jumps past the goal).
+    """
+    p = np.atleast_2d(np.asarray(points, float))
+    step = cfg.step_gain * apf_force(p, goal, obstacles, cfg)
+    length = np.linalg.norm(step, axis=1, keepdims=True)
+    to_goal = np.linalg.norm(p - np.asarray(goal, float), axis=1, keepdims=True)
+    limit = np.minimum(cfg.max_step, np.maximum(to_goal, 1e-9))
+    scale = np.where(length > limit, limit / np.maximum(length, 1e-12), 1.0)
+    return p + step * scale

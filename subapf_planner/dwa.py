@@ -1,0 +1,89 @@
+"""Dynamic Window Approach baseline (Fox, Burgard and Thrun, 1997).
+
+The classic local planner a TurtleBot3 user would otherwise pick. Velocity
+pairs (v, w) reachable within one planning period under the acceleration
+limits are rolled out as circular arcs over ``dwa_horizon`` seconds; an arc
+that passes closer than ``danger_distance`` to an obstacle point is not
+admissible (turning on the spot always is, since the footprint is round).
+Among the admissible arcs the one maximising
+
+    heading_weight * heading + clearance_weight * clearance + velocity_weight * v/v_max
+
+wins. Each term lies in [0, 1] (heading: 1 - |goal bearing error at the arc's
+end| / pi; clearance: capped at 1 m; speed: v / v_max). Unlike the paper, the
+terms are not min-max normalised over the window, which would blow tiny
+clearance differences up and make the robot turn on the spot.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from .config import PlannerConfig
+from .sampling import clearance
+
+#: Rollout resolution [s].
+ROLLOUT_DT = 0.1
+#: Clearances above this count as fully clear in the score [m].
+CLEARANCE_CAP = 1.0
+
+
+@dataclass(frozen=True)
+class DwaResult:
+    """Chosen (v [m/s], w [rad/s]), whether any arc was admissible, and the chosen arc."""
+
+    v: float
+    w: float
+    admissible: bool
+    trajectory: NDArray[np.float64]
+
+
+def rollout(pose: ArrayLike, v: NDArray, w: NDArray, horizon: float) -> NDArray[np.float64]:
+    """Positions (k, T, 2) of k unicycle arcs (v, w) from pose (x, y, yaw), T steps of 0.1 s."""
+    x, y, yaw = (float(c) for c in pose)
+    t = ROLLOUT_DT * np.arange(1, max(1, int(round(horizon / ROLLOUT_DT))) + 1)
+    v = np.asarray(v, float)[:, None]
+    w = np.asarray(w, float)[:, None]
+    th = yaw + w * t
+    straight = np.abs(w) < 1e-6
+    w_safe = np.where(straight, 1.0, w)
+    px = np.where(straight, x + v * t * math.cos(yaw), x + v / w_safe * (np.sin(th)
+                                                                           - math.sin(yaw)))
+    py = np.where(straight, y + v * t * math.sin(yaw), y - v / w_safe * (np.cos(th)
+                                                                           - math.cos(yaw)))
+    return np.stack((px, py), axis=-1)
+
+
+def dwa_command(pose: ArrayLike, goal: ArrayLike, previous: tuple[float, float],
+                obstacles: ArrayLike, cfg: PlannerConfig) -> DwaResult:
+    """Best admissible (v, w) of the dynamic window around ``previous``."""
+    v0, w0 = previous
+    dt = cfg.period
+    v_lo = max(0.0, v0 - cfg.max_linear_acceleration * dt)
+    v_hi = min(cfg.max_linear_velocity, v0 + cfg.max_linear_acceleration * dt)
+    w_lo = max(-cfg.max_angular_velocity, w0 - cfg.max_angular_acceleration * dt)
+    w_hi = min(cfg.max_angular_velocity, w0 + cfg.max_angular_acceleration * dt)
+    vs, ws = np.meshgrid(np.linspace(v_lo, max(v_lo, v_hi), cfg.dwa_v_samples),
+                         np.linspace(w_lo, max(w_lo, w_hi), cfg.dwa_w_samples))
+    vs, ws = vs.ravel(), ws.ravel()
+    paths = rollout(pose, vs, ws, cfg.dwa_horizon)
+    k, steps, _ = paths.shape
+    clear = clearance(paths.reshape(-1, 2), obstacles).reshape(k, steps).min(axis=1)
+    admissible = (clear > cfg.danger_distance) | (vs <= 1e-9)
+    if not np.any(admissible):
+        return DwaResult(0.0, 0.0, False, np.asarray(pose, float)[None, :2].copy())
+    end = paths[:, -1, :]
+    end_yaw = float(pose[2]) + ws * cfg.dwa_horizon
+    g = np.asarray(goal, float)
+    bearing = np.arctan2(g[1] - end[:, 1], g[0] - end[:, 0])
+    heading = 1.0 - np.abs(np.remainder(bearing - end_yaw + np.pi, 2 * np.pi) - np.pi) / np.pi
+    score = (cfg.dwa_heading_weight * heading
+             + cfg.dwa_clearance_weight * np.minimum(clear, CLEARANCE_CAP) / CLEARANCE_CAP
+             + cfg.dwa_velocity_weight * vs / max(cfg.max_linear_velocity, 1e-9))
+    score = np.where(admissible, score, -np.inf)
+    best = int(np.argmax(score))
+    return DwaResult(float(vs[best]), float(ws[best]), True, paths[best].copy())

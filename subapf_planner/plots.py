@@ -1,0 +1,58 @@
+"""Trajectory plots in the style of the paper's Fig. 6 (matplotlib, headless Agg)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Mapping
+
+import matplotlib
+
+matplotlib.use('Agg')
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+
+from .world import World, obstacle_outline  # noqa: E402
+
+METHOD_STYLE = {
+    'subharmonic_sampling': ('tab:red', 'subharmonic + sampling'),
+    'subharmonic': ('tab:orange', 'subharmonic'),
+    'traditional': ('tab:blue', 'traditional 1/r'),
+    'harmonic': ('tab:green', 'harmonic log'),
+    'dwa': ('tab:purple', 'DWA'),
+}
+
+
+def draw_world(ax: plt.Axes, world: World) -> None:
+    """Obstacles (grey), start (black triangle) and goal (star with tolerance circle)."""
+    for o in world.all_obstacles():
+        outline = obstacle_outline(o)
+        ax.fill(outline[:, 0], outline[:, 1], color='0.55', zorder=1)
+    sx, sy, _ = world.start
+    ax.plot(sx, sy, 'k^', ms=9, zorder=4)
+    ax.plot(*world.goal, 'k*', ms=13, zorder=4)
+    ax.add_patch(plt.Circle(world.goal, world.goal_tolerance, fill=False, ls=':', color='k'))
+    ax.set_aspect('equal')
+    ax.grid(True, alpha=0.3)
+    ax.set_xlabel('x [m]')
+    ax.set_ylabel('y [m]')
+
+
+def plot_trajectories(world: World, paths: Mapping[str, np.ndarray],
+                      outcomes: Mapping[str, str], out: str | Path) -> Path:
+    """One PNG: the world and each method's driven path with its outcome."""
+    fig, ax = plt.subplots(figsize=(6.5, 6.5))
+    draw_world(ax, world)
+    for method, path in paths.items():
+        color, label = METHOD_STYLE.get(method, ('k', method))
+        if len(path):
+            ax.plot(path[:, 0], path[:, 1], color=color, lw=1.6,
+                    label=f'{label}: {outcomes.get(method, "?")}', zorder=3)
+            ax.plot(path[-1, 0], path[-1, 1], 'o', color=color, ms=4, zorder=3)
+    ax.set_title(world.name)
+    ax.legend(loc='best', fontsize=8)
+    out = Path(out)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    fig.tight_layout()
+    fig.savefig(out, dpi=110)
+    plt.close(fig)
+    return out

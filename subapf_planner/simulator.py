@@ -1,0 +1,255 @@
+"""Headless PyBullet stand-in for a TurtleBot3 burger (ROS-free, seeded, fixed dt).
+
+The robot is a real multibody (urdf/burger_standin.urdf) whose two wheels are
+velocity-controlled from (v, w): slip and acceleration are what PyBullet's
+contact model gives. The lidar is an LDS-01-like 2-D scanner made with
+``rayTestBatch``: 360 beams from angle 0, 0.12 to 3.5 m, no-return beams as
++inf, optional Gaussian range noise and dropped beams (also +inf). Odometry
+is the base's motion, optionally with drift; the ground truth is kept apart
+for scoring. The simulator's odom frame is the world frame.
+
+Like the real burger's base, a command older than ``cmd_timeout`` of simulated
+time is replaced by zero velocity (the watchdog).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import math
+import os
+import sys
+from collections.abc import Iterator
+from dataclasses import dataclass
+from importlib import resources
+
+import numpy as np
+import pybullet
+from pybullet_utils.bullet_client import BulletClient
+
+from .world import Box, Circle, World
+
+OBSTACLE_HEIGHT = 0.5
+WHEEL_RADIUS = 0.033
+WHEEL_SEPARATION = 0.160
+#: base_scan in base_footprint (base_link is 0.010 m above base_footprint).
+LASER_OFFSET = (-0.032, 0.0, 0.182)
+
+
+@contextlib.contextmanager
+def _quiet_stdout() -> Iterator[None]:
+    """Silence the C-level banner PyBullet prints to stdout on connect."""
+    sys.stdout.flush()
+    saved = os.dup(1)
+    try:
+        with open(os.devnull, 'w') as null:
+            os.dup2(null.fileno(), 1)
+            yield
+    finally:
+        os.dup2(saved, 1)
+        os.close(saved)
+
+
+@dataclass(frozen=True)
+class SimConfig:
+    """Simulator settings (SI units). Defaults: the burger and its LDS-01."""
+
+    physics_dt: float = 0.005
+    scan_beams: int = 360
+    range_min: float = 0.12
+    range_max: float = 3.5
+    range_noise: float = 0.0
+    beam_dropout: float = 0.0
+    odom_noise: float = 0.0
+    max_linear_velocity: float = 0.22
+    max_angular_velocity: float = 2.84
+    wheel_torque: float = 0.5
+    cmd_timeout: float = 0.5
+    seed: int = 0
+
+    def __post_init__(self) -> None:
+        checks = {
+            'physics_dt': 0.0 < self.physics_dt <= 0.05,
+            'scan_beams': isinstance(self.scan_beams, int) and 1 <= self.scan_beams <= 4096,
+            'range_min': 0.0 <= self.range_min < self.range_max,
+            'range_max': 0.0 < self.range_max <= 100.0,
+            'range_noise': 0.0 <= self.range_noise <= 1.0,
+            'beam_dropout': 0.0 <= self.beam_dropout <= 1.0,
+            'odom_noise': 0.0 <= self.odom_noise <= 1.0,
+            'max_linear_velocity': self.max_linear_velocity >= 0.0,
+            'max_angular_velocity': self.max_angular_velocity >= 0.0,
+            'wheel_torque': self.wheel_torque > 0.0,
+            'cmd_timeout': self.cmd_timeout > 0.0,
+        }
+        for name, ok in checks.items():
+            if not ok:
+                raise ValueError(f'{name}: invalid value {getattr(self, name)!r}')
+
+
+@dataclass(frozen=True)
+class Scan:
+    """One lidar sweep in base_scan; ranges [m], +inf for no return."""
+
+    stamp: float
+    ranges: np.ndarray
+    angle_min: float
+    angle_increment: float
+    range_min: float
+    range_max: float
+
+
+class BurgerSim:
+    """One world, one robot, fixed-step physics. Not thread-safe."""
+
+    def __init__(self, world: World, config: SimConfig | None = None) -> None:
+        self.world = world
+        self.config = config or SimConfig()
+        self._rng = np.random.default_rng(self.config.seed)
+        with _quiet_stdout():
+            self._client = BulletClient(connection_mode=pybullet.DIRECT)
+        self._build()
+        self.time = 0.0
+        self.collided = False
+        self._cmd = (0.0, 0.0)
+        self._cmd_time = -math.inf
+        x, y, yaw = world.start
+        self._odom = np.array([x, y, yaw])
+        self._truth_prev = self.true_pose()
+        n = self.config.scan_beams
+        self._angles = 2.0 * math.pi * np.arange(n) / n
+
+    def _build(self) -> None:
+        c = self._client
+        c.resetSimulation()
+        c.setGravity(0, 0, -9.81)
+        c.setTimeStep(self.config.physics_dt)
+        plane = c.createCollisionShape(pybullet.GEOM_PLANE)
+        self._plane = c.createMultiBody(0, plane)
+        c.changeDynamics(self._plane, -1, lateralFriction=1.0)
+        self._obstacles = [self._add_obstacle(o) for o in self.world.all_obstacles()]
+        x, y, yaw = self.world.start
+        with resources.as_file(resources.files(__package__) / 'urdf'
+                               / 'burger_standin.urdf') as urdf:
+            self.robot = c.loadURDF(str(urdf), [x, y, 0.001],
+                                    c.getQuaternionFromEuler([0, 0, yaw]))
+        c.changeDynamics(self.robot, -1, lateralFriction=0.0, spinningFriction=0.0,
+                         rollingFriction=0.0)
+        names = {c.getJointInfo(self.robot, j)[1].decode(): j
+                 for j in range(c.getNumJoints(self.robot))}
+        self._wheels = (names['wheel_left_joint'], names['wheel_right_joint'])
+        for j in self._wheels:
+            c.changeDynamics(self.robot, j, lateralFriction=1.0)
+
+    def _add_obstacle(self, o: Circle | Box) -> int:
+        c = self._client
+        h = OBSTACLE_HEIGHT
+        if isinstance(o, Circle):
+            shape = c.createCollisionShape(pybullet.GEOM_CYLINDER, radius=o.radius, height=h)
+            orn = [0, 0, 0, 1]
+        else:
+            shape = c.createCollisionShape(pybullet.GEOM_BOX,
+                                           halfExtents=[o.size[0] / 2, o.size[1] / 2, h / 2])
+            orn = c.getQuaternionFromEuler([0, 0, o.yaw])
+        return c.createMultiBody(0, shape, basePosition=[o.center[0], o.center[1], h / 2],
+                                 baseOrientation=orn)
+
+    def close(self) -> None:
+        """Release the physics server."""
+        if self._client is not None:
+            self._client.disconnect()
+            self._client = None
+
+    def __enter__(self) -> 'BurgerSim':
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+    # --- commands and stepping ----------------------------------------------------------
+    def set_command(self, v: float, w: float) -> None:
+        """Velocity command [m/s, rad/s], clamped to the burger's limits; NaN -> 0."""
+        cfg = self.config
+        v = 0.0 if not math.isfinite(v) else max(-cfg.max_linear_velocity,
+                                                 min(cfg.max_linear_velocity, v))
+        w = 0.0 if not math.isfinite(w) else max(-cfg.max_angular_velocity,
+                                                 min(cfg.max_angular_velocity, w))
+        self._cmd = (v, w)
+        self._cmd_time = self.time
+
+    def _apply_wheels(self) -> None:
+        v, w = self._cmd
+        if self.time - self._cmd_time > self.config.cmd_timeout:
+            v, w = 0.0, 0.0
+        left = (v - w * WHEEL_SEPARATION / 2) / WHEEL_RADIUS
+        right = (v + w * WHEEL_SEPARATION / 2) / WHEEL_RADIUS
+        self._client.setJointMotorControlArray(
+            self.robot, list(self._wheels), pybullet.VELOCITY_CONTROL,
+            targetVelocities=[left, right], forces=[self.config.wheel_torque] * 2)
+
+    def step(self, duration: float) -> None:
+        """Advance by ``duration`` seconds (rounded to whole physics steps)."""
+        c = self._client
+        for _ in range(max(1, int(round(duration / self.config.physics_dt)))):
+            self._apply_wheels()
+            c.stepSimulation()
+            self.time += self.config.physics_dt
+            self._integrate_odom()
+            if not self.collided and self._touching_obstacle():
+                self.collided = True
+
+    def _touching_obstacle(self) -> bool:
+        return any(cp[2] != self._plane for cp in self._client.getContactPoints(self.robot))
+
+    # --- state --------------------------------------------------------------------------
+    def true_pose(self) -> np.ndarray:
+        """Ground-truth (x, y, yaw) of base_footprint in the world frame."""
+        pos, orn = self._client.getBasePositionAndOrientation(self.robot)
+        yaw = self._client.getEulerFromQuaternion(orn)[2]
+        return np.array([pos[0], pos[1], yaw])
+
+    def true_velocity(self) -> tuple[float, float]:
+        """Ground-truth forward speed [m/s] and yaw rate [rad/s] in the body frame."""
+        lin, ang = self._client.getBaseVelocity(self.robot)
+        yaw = self.true_pose()[2]
+        return lin[0] * math.cos(yaw) + lin[1] * math.sin(yaw), ang[2]
+
+    def _integrate_odom(self) -> None:
+        truth = self.true_pose()
+        if self.config.odom_noise == 0.0:
+            self._odom = truth
+        else:
+            prev = self._truth_prev
+            c, s = math.cos(prev[2]), math.sin(prev[2])
+            dx, dy = truth[0] - prev[0], truth[1] - prev[1]
+            fwd, lat = c * dx + s * dy, -s * dx + c * dy
+            dyaw = math.remainder(truth[2] - prev[2], 2 * math.pi)
+            fwd, lat, dyaw = np.array([fwd, lat, dyaw]) * (
+                1.0 + self.config.odom_noise * self._rng.standard_normal(3))
+            oc, os_ = math.cos(self._odom[2]), math.sin(self._odom[2])
+            self._odom = self._odom + [oc * fwd - os_ * lat, os_ * fwd + oc * lat, dyaw]
+            self._odom[2] = math.remainder(self._odom[2], 2 * math.pi)
+        self._truth_prev = truth
+
+    def odometry(self) -> tuple[np.ndarray, tuple[float, float]]:
+        """Odometry pose (x, y, yaw) in odom and body twist (v, w)."""
+        return self._odom.copy(), self.true_velocity()
+
+    def scan(self) -> Scan:
+        """One LDS-01-like sweep from base_scan at the current pose."""
+        cfg = self.config
+        x, y, yaw = self.true_pose()
+        c, s = math.cos(yaw), math.sin(yaw)
+        ox = x + c * LASER_OFFSET[0] - s * LASER_OFFSET[1]
+        oy = y + s * LASER_OFFSET[0] + c * LASER_OFFSET[1]
+        a = self._angles + yaw
+        n = a.size
+        origin = np.tile([ox, oy, LASER_OFFSET[2]], (n, 1))
+        ends = origin + cfg.range_max * np.column_stack((np.cos(a), np.sin(a), np.zeros(n)))
+        hits = self._client.rayTestBatch(origin.tolist(), ends.tolist())
+        frac = np.array([h[2] if h[0] >= 0 else np.inf for h in hits])
+        ranges = frac * cfg.range_max
+        if cfg.range_noise > 0.0:
+            ranges = ranges + cfg.range_noise * self._rng.standard_normal(n)
+        if cfg.beam_dropout > 0.0:
+            ranges[self._rng.random(n) < cfg.beam_dropout] = np.inf
+        ranges[(ranges < cfg.range_min) | (ranges >= cfg.range_max)] = np.inf
+        return Scan(self.time, ranges, 0.0, 2.0 * math.pi / n, cfg.range_min, cfg.range_max)
