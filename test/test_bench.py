@@ -1,0 +1,59 @@
+"""Benchmark: results.json keys and consistency; the paper's qualitative claims."""
+
+import json
+
+import pytest
+
+from subapf_planner.bench import main
+from subapf_planner.config import PlannerConfig
+from subapf_planner.episode import run_episode
+from subapf_planner.world import load_world
+
+KEYS = {'world', 'method', 'outcome', 'time_s', 'path_length', 'min_clearance',
+        'mean_abs_curvature', 'plan_ms_median', 'plan_ms_p99', 'cycles'}
+
+
+def test_short_bench_writes_consistent_results(tmp_path, worlds_dir):
+    out = tmp_path / 'out'
+    rc = main([str(worlds_dir / 'four_points.yaml'), str(worlds_dir / 'fig6c_circle_in_front.yaml'),
+               '--methods', 'subharmonic_sampling,dwa', '--out', str(out)])
+    assert rc == 0
+    runs = json.loads((out / 'results.json').read_text())['runs']
+    assert len(runs) == 4
+    for r in runs:
+        assert KEYS <= set(r)
+        assert r['outcome'] in ('reached', 'collision', 'timeout')
+        if r['outcome'] == 'reached':
+            assert r['final_distance'] <= r['goal_tolerance']
+            assert r['path_length'] >= 0.9 * 5.0 - r['goal_tolerance'] or r['world'] != 'four_points'
+        if r['outcome'] == 'collision':
+            assert r['min_clearance'] <= 0.01
+        assert r['cycles'] >= 1 and r['plan_ms_p99'] >= r['plan_ms_median'] > 0
+    assert (out / 'summary.md').read_text().startswith('| method |')
+    assert (out / 'four_points.png').stat().st_size > 10_000
+
+
+def test_bench_rejects_unknown_method_and_bad_world(tmp_path, capsys):
+    assert main(['--methods', 'magic', '--out', str(tmp_path)]) == 2
+    assert 'unknown method' in capsys.readouterr().err
+    bad = tmp_path / 'bad.yaml'
+    bad.write_text('name: x\n')
+    assert main([str(bad), '--out', str(tmp_path)]) == 2
+    assert 'start: missing' in capsys.readouterr().err
+
+
+# The paper's Fig. 6 claims, asserted where they hold with one parameter set
+# (config/planner.yaml defaults) on the shipped worlds. See README 'Results'.
+@pytest.mark.parametrize('name', ['fig6c_circle_in_front', 'fig6d_big_wall'])
+def test_only_sampling_passes_the_local_minima(worlds_dir, name):
+    world = load_world(worlds_dir / f'{name}.yaml')
+    outcomes = {m: run_episode(world, PlannerConfig(method=m)).outcome
+                for m in ('subharmonic_sampling', 'subharmonic', 'traditional', 'harmonic')}
+    assert outcomes['subharmonic_sampling'] == 'reached'
+    assert all(outcomes[m] != 'reached' for m in ('subharmonic', 'traditional', 'harmonic'))
+
+
+def test_full_method_passes_narrow_and_tight_worlds_without_collision(worlds_dir):
+    for name in ('fig6a_narrow_obstacles', 'fig6b_tight_space', 'fig3_narrowing_passage'):
+        world = load_world(worlds_dir / f'{name}.yaml')
+        assert run_episode(world, PlannerConfig()).outcome == 'reached', name

@@ -1,0 +1,50 @@
+"""Command shaping for the differential drive."""
+
+import math
+
+import numpy as np
+import pytest
+
+from subapf_planner.command import forward_blocked, shape_command
+from subapf_planner.config import PlannerConfig
+
+CFG = PlannerConfig()
+NONE = np.zeros((0, 2))
+
+
+def test_goal_reached_and_no_safe_move_stop():
+    assert shape_command((0, 0, 0), (1, 0), (0.1, 0), (0.2, 0), NONE, CFG).status == 'reached'
+    c = shape_command((0, 0, 0), None, (3, 0), (0.2, 0.5), NONE, CFG)
+    assert (c.v, c.w, c.status) == (0.0, 0.0, 'no_safe_move')
+
+
+def test_rotate_in_place_when_target_behind():
+    c = shape_command((0, 0, 0), (-0.05, 0.001), (-3, 0), (0.0, 0.0), NONE, CFG)
+    assert c.v == 0.0 and c.status == 'turning' and c.w > 0
+
+
+def test_limits_and_acceleration():
+    c = shape_command((0, 0, 0), (1.0, 0.0), (5, 0), (0.0, 0.0), NONE, CFG)
+    assert c.v == pytest.approx(CFG.max_linear_acceleration * CFG.period)
+    c = shape_command((0, 0, 0), (1.0, 0.0), (5, 0), (0.22, 0.0), NONE, CFG)
+    assert c.v == pytest.approx(CFG.max_linear_velocity)
+    c = shape_command((0, 0, 0), (0.0, 1.0), (0, 5), (0.0, 2.84), NONE, CFG)
+    assert abs(c.w) <= CFG.max_angular_velocity
+
+
+def test_slowdown_near_goal():
+    far = shape_command((0, 0, 0), (0.1, 0), (3.0, 0), (0.22, 0), NONE, CFG)
+    near = shape_command((0, 0, 0), (0.1, 0), (0.2, 0), (0.22, 0), NONE, CFG)
+    assert near.v < far.v
+
+
+def test_forward_corridor_blocks_only_ahead():
+    ahead = np.array([[0.2, 0.05]])
+    beside = np.array([[0.0, 0.2]])
+    behind = np.array([[-0.15, 0.0]])
+    assert forward_blocked((0, 0, 0), ahead, CFG)
+    assert not forward_blocked((0, 0, 0), beside, CFG)
+    assert not forward_blocked((0, 0, 0), behind, CFG)
+    assert forward_blocked((1, 1, math.pi / 2), ahead[:, ::-1] + 1, CFG)
+    c = shape_command((0, 0, 0), (0.1, 0.0), (3, 0), (0.2, 0), ahead, CFG)
+    assert c.v == 0.0 and c.status == 'blocked_ahead'

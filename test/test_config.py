@@ -1,0 +1,48 @@
+"""Configuration: validation and the YAML documenting every parameter."""
+
+import dataclasses
+
+import pytest
+import yaml
+
+from conftest import PARAMS
+from subapf_planner.config import ConfigError, PlannerConfig, from_mapping, load_config
+
+
+def test_yaml_lists_every_core_parameter_with_its_default():
+    params = yaml.safe_load(PARAMS.read_text())['subapf_planner']['ros__parameters']
+    for f in dataclasses.fields(PlannerConfig):
+        assert f.name in params, f'{f.name} missing from config/planner.yaml'
+        assert params[f.name] == f.default, f.name
+    assert load_config(PARAMS) == PlannerConfig()
+
+
+@pytest.mark.parametrize('changes, message', [
+    ({'danger_distance': -1.0}, 'danger_distance'),
+    ({'danger_distance': float('nan')}, 'danger_distance: must be finite'),
+    ({'num_samples': 2}, 'num_samples'),
+    ({'num_samples': 16.5}, 'num_samples: expected an integer'),
+    ({'method': 'magic'}, "method: 'magic' is not one of"),
+    ({'max_linear_velocity': 'fast'}, 'max_linear_velocity: expected a number'),
+    ({'use_gpu': True}, 'unknown parameter'),
+])
+def test_bad_values_name_the_parameter(changes, message):
+    with pytest.raises(ConfigError, match=message):
+        from_mapping(changes)
+
+
+def test_replace_validates_and_k_follows_d0():
+    cfg = PlannerConfig().replace(danger_distance=0.2)
+    assert cfg.k == pytest.approx(25.0)
+    with pytest.raises(ConfigError):
+        cfg.replace(sample_radius=-1.0)
+
+
+def test_bad_params_file(tmp_path):
+    bad = tmp_path / 'p.yaml'
+    bad.write_text('other_node:\n  ros__parameters: {}\n')
+    with pytest.raises(ConfigError, match='no "subapf_planner: ros__parameters:"'):
+        load_config(bad)
+    bad.write_text('subapf_planner:\n  ros__parameters:\n    goal_tolerance: -3\n')
+    with pytest.raises(ConfigError, match='goal_tolerance'):
+        load_config(bad)

@@ -1,0 +1,66 @@
+"""Scan conversion: invalid beams dropped, geometry right, downsampling."""
+
+import math
+
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from hypothesis.extra.numpy import arrays
+import numpy as np
+import pytest
+
+from subapf_planner.scan import ScanError, scan_to_points, valid_beams, voxel_downsample
+
+ranges_st = arrays(np.float64, st.integers(0, 500),
+                   elements=st.one_of(st.floats(allow_nan=True, allow_infinity=True),
+                                      st.floats(0.0, 5.0)))
+
+
+@given(r=ranges_st)
+@settings(max_examples=300, deadline=None)
+def test_only_valid_returns_become_points(r):
+    pts = scan_to_points(r, 0.0, 2 * math.pi / max(len(r), 1), 0.12, 3.5, (1.0, -2.0, 0.3))
+    expected = np.sum(np.isfinite(r) & (r >= 0.12) & (r < 3.5))
+    assert pts.shape == (expected, 2)
+    assert np.all(np.isfinite(pts))
+    if expected:
+        d = np.hypot(pts[:, 0] - 1.0, pts[:, 1] + 2.0)
+        assert np.all(d >= 0.12 - 1e-9) and np.all(d < 3.5)
+
+
+def test_lds01_zero_and_lds02_nan_are_dropped():
+    r = np.array([0.0, np.nan, np.inf, -np.inf, -1.0, 0.05, 1.0, 3.5, 100.0])
+    assert valid_beams(r, 0.12, 3.5).tolist() == [False] * 6 + [True, False, False]
+    assert valid_beams(r, 0.0, 100.0).tolist() == [False] * 5 + [True, True, True, False]
+
+
+def test_geometry_with_pose_and_laser_offset():
+    # one beam straight ahead at 1 m, laser 0.1 m behind the base, robot at (2, 3) facing +y
+    pts = scan_to_points([1.0], 0.0, 0.01, 0.1, 3.5, (2.0, 3.0, math.pi / 2), (-0.1, 0.0, 0.0))
+    np.testing.assert_allclose(pts, [[2.0, 3.9]], atol=1e-12)
+    # beam at +90 deg in a laser yawed by pi
+    pts = scan_to_points([0.0, 1.0], 0.0, math.pi / 2, 0.1, 3.5, (0, 0, 0), (0, 0, math.pi))
+    np.testing.assert_allclose(pts, [[0.0, -1.0]], atol=1e-12)
+
+
+def test_empty_scan_and_bad_geometry():
+    assert scan_to_points([], 0.0, 0.0, 0.1, 3.5, (0, 0, 0)).shape == (0, 2)
+    with pytest.raises(ScanError, match='angle_increment'):
+        scan_to_points([1.0, 1.0], 0.0, 0.0, 0.1, 3.5, (0, 0, 0))
+    with pytest.raises(ScanError, match='angle_increment'):
+        scan_to_points([1.0, 1.0], 0.0, -0.1, 0.1, 3.5, (0, 0, 0))
+    with pytest.raises(ScanError, match='non-finite'):
+        scan_to_points([1.0], math.nan, 0.1, 0.1, 3.5, (0, 0, 0))
+
+
+def test_voxel_downsample_bounds_wall_density():
+    dense = np.column_stack((np.linspace(0, 0.999, 1000), np.full(1000, 0.52)))
+    sparse = dense[25::50]   # one beam per 5 cm
+    a, b = voxel_downsample(dense, 0.05), voxel_downsample(sparse, 0.05)
+    assert len(a) == 20 and len(b) == 20   # 1 m of wall: 20 cells, whatever the density
+    # every input point is within one cell diagonal of a kept point
+    d = np.min(np.hypot(*(dense[:, None, :] - a[None]).transpose(2, 0, 1)), axis=1)
+    assert d.max() <= 0.05 * math.sqrt(2)
+    x = dense.copy()
+    voxel_downsample(x, 0.05)
+    np.testing.assert_array_equal(x, dense)
+    np.testing.assert_array_equal(voxel_downsample(dense, 0.0), dense)
