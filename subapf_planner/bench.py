@@ -9,12 +9,12 @@ One parameter file (default: the package's config/planner.yaml) for all worlds.
 from __future__ import annotations
 
 import argparse
+from concurrent.futures import ProcessPoolExecutor
 import json
+from pathlib import Path
 import statistics
 import sys
 import time
-from concurrent.futures import ProcessPoolExecutor
-from pathlib import Path
 
 import numpy as np
 from tqdm import tqdm
@@ -118,7 +118,7 @@ def main(argv: list[str] | None = None) -> int:
                                     + f'\n{len(runs)} runs in {wall:.1f} s wall time.\n')
     if not args.no_plots:
         for f, world in worlds.items():
-            sel = [(job, res) for job, res in zip(jobs, results) if job[0] == f]
+            sel = [(job, res) for job, res in zip(jobs, results, strict=True) if job[0] == f]
             plot_trajectories(world, {j[1]: np.asarray(p) for j, (_, p) in sel},
                               {j[1]: r['outcome'] for j, (r, _) in sel},
                               out / f'{world.name}.png')

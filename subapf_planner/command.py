@@ -11,8 +11,8 @@ ahead within the danger distance. Stops are immediate (not rate limited).
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
+import math
 
 import numpy as np
 from numpy.typing import ArrayLike

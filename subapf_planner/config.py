@@ -9,8 +9,8 @@ apart (``test/test_config.py`` checks the YAML against this module).
 from __future__ import annotations
 
 import dataclasses
-import math
 from dataclasses import dataclass, field
+import math
 from pathlib import Path
 from typing import Any, Mapping
 
@@ -36,7 +36,7 @@ class PlannerConfig:
     """All parameters of the planner core; see README 'Parameters'."""
 
     # --- method and potentials (paper Sections II-III) ---------------------------------
-    method: str = _param('subharmonic_sampling', 'Planner: the paper\'s full method, '
+    method: str = _param('subharmonic_sampling', "Planner: the paper's full method, "
                          'its ablations, or the DWA baseline', choices=METHODS)
     attraction: str = _param('conic', 'Attractive potential: quadratic a_att*r^2 (eq. 21) or '
                              'conic a_att*r (constant-magnitude pull, what Section II-C '
@@ -69,7 +69,7 @@ class PlannerConfig:
                                    'm', 0.0, 10.0)
     # --- scan conversion ---------------------------------------------------------------
     voxel_size: float = _param(0.05, 'Grid cell for downsampling laser points (one point per '
-                               'cell), so a wall\'s push does not grow with beam density',
+                               "cell), so a wall's push does not grow with beam density",
                                'm', 0.0, 1.0)
     obstacle_range: float = _param(3.5, 'Laser returns beyond this are ignored', 'm',
                                    0.1, 100.0)

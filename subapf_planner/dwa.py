@@ -17,8 +17,8 @@ clearance differences up and make the robot turn on the spot.
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
+import math
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray

@@ -8,9 +8,9 @@ simulated second. The same loop underlies ``subapf-bench``.
 
 from __future__ import annotations
 
+from dataclasses import dataclass, field
 import math
 import time
-from dataclasses import dataclass, field
 
 import numpy as np
 

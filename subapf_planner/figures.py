@@ -11,8 +11,8 @@ passage world, one trajectory per repulsion.
 from __future__ import annotations
 
 import argparse
-import sys
 from pathlib import Path
+import sys
 
 import matplotlib
 
@@ -41,7 +41,7 @@ def world_points(world: World, spacing: float = 0.05) -> np.ndarray:
     pts = []
     for o in world.all_obstacles():
         outline = obstacle_outline(o, n=max(8, int(60 * spacing ** -0.5)))
-        for a, b in zip(outline[:-1], outline[1:]):
+        for a, b in zip(outline[:-1], outline[1:], strict=True):
             n = max(1, int(np.ceil(np.hypot(*(b - a)) / spacing)))
             pts.append(a + (b - a) * (np.arange(n)[:, None] / n))
     return np.vstack(pts) if pts else np.zeros((0, 2))
@@ -63,7 +63,7 @@ def fig1(out: Path) -> Path:
     gx, gy = np.meshgrid(xs, xs)
     xy = np.column_stack((gx.ravel(), gy.ravel()))
     fig, axes = plt.subplots(1, 3, figsize=(14, 4.4), subplot_kw={'projection': '3d'})
-    for ax, kind, title in zip(axes, ('harmonic', 'traditional', 'subharmonic'),
+    for ax, kind, title in zip(axes, ('harmonic', 'traditional', 'subharmonic'),  # noqa: B905
                                ('-sum log10 r (harmonic): saddle at 0',
                                 '+sum 1/r (traditional): minimum at 0',
                                 '+sum exp(-4 r^2): also a minimum at 0')):

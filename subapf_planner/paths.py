@@ -7,8 +7,8 @@ install's share/ folder), then the source checkout this module lives in.
 from __future__ import annotations
 
 import os
-import sys
 from pathlib import Path
+import sys
 
 PACKAGE = 'subapf_planner'
 

@@ -14,8 +14,8 @@ raw point (the paper's ablations); ``dwa`` replaces steps 2-4 (dwa.py).
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, field
+import math
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -112,14 +112,20 @@ class Planner:
         return result
 
     def step_scan(self, pose: ArrayLike, goal: ArrayLike, ranges: ArrayLike, angle_min: float,
-                  angle_increment: float, range_min: float, range_max: float) -> PlanResult:
-        """Plan from a laser scan taken at ``pose``; see scan.scan_to_points."""
+                  angle_increment: float, range_min: float, range_max: float,
+                  scan_pose: ArrayLike | None = None) -> PlanResult:
+        """Plan from a laser scan; see scan.scan_to_points.
+
+        ``scan_pose`` is the robot's odom pose when the scan was taken (default:
+        ``pose``); a robot that moved since is planned for from ``pose``.
+        """
         cfg = self.cfg
+        scan_pose = pose if scan_pose is None else scan_pose
         if not np.all(np.isfinite(np.asarray(pose, float))):
             return self.step(pose, goal, _EMPTY)
         try:
             pts = scan_to_points(ranges, angle_min, angle_increment, range_min, range_max,
-                                 pose, (cfg.laser_x, cfg.laser_y, cfg.laser_yaw),
+                                 scan_pose, (cfg.laser_x, cfg.laser_y, cfg.laser_yaw),
                                  cfg.obstacle_range)
         except ScanError:
             self.reset()

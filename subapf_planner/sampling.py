@@ -28,15 +28,14 @@ and ``chosen`` is None: the caller stops the robot.
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
+import math
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from .apf import apf_step
 from .config import PlannerConfig
-
 
 #: A priority sample may be this fraction of R closer to the obstacles than the robot.
 PRIORITY_SLACK = 0.1

@@ -14,13 +14,13 @@ time is replaced by zero velocity (the watchdog).
 
 from __future__ import annotations
 
+from collections.abc import Iterator
 import contextlib
+from dataclasses import dataclass
+from importlib import resources
 import math
 import os
 import sys
-from collections.abc import Iterator
-from dataclasses import dataclass
-from importlib import resources
 
 import numpy as np
 import pybullet

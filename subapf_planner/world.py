@@ -8,8 +8,8 @@ Every error names the file, the field and what was wrong.
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
+import math
 from pathlib import Path
 from typing import Any
 

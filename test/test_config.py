@@ -2,10 +2,10 @@
 
 import dataclasses
 
+from conftest import PARAMS
 import pytest
 import yaml
 
-from conftest import PARAMS
 from subapf_planner.config import ConfigError, PlannerConfig, from_mapping, load_config
 
 

@@ -8,8 +8,14 @@ import numpy as np
 import pytest
 
 from subapf_planner.potentials import (
-    attractive_gradient, attractive_value, max_subharmonic_slope, repulsive_dr,
-    repulsive_field, repulsive_laplacian, repulsive_value)
+    attractive_gradient,
+    attractive_value,
+    max_subharmonic_slope,
+    repulsive_dr,
+    repulsive_field,
+    repulsive_laplacian,
+    repulsive_value,
+)
 
 KINDS = ('traditional', 'harmonic', 'subharmonic')
 FOUR = np.array([[1.0, 1.0], [-1.0, -1.0], [-1.0, 1.0], [1.0, -1.0]])

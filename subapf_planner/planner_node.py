@@ -1,0 +1,279 @@
+"""``planner_node`` (``subapf-planner``): scan + odom + goal -> cmd_vel at 5 Hz.
+
+Topics (relative, so namespaces and remapping work):
+  in:  scan (sensor_msgs/LaserScan, sensor-data QoS), odom (nav_msgs/Odometry),
+       goal_pose (geometry_msgs/PoseStamped, in the odom frame)
+  out: cmd_vel (geometry_msgs/TwistStamped, or Twist with
+       enable_stamped_cmd_vel:=false), ~/status (std_msgs/String,
+       "state: reason"), ~/markers (visualization_msgs/MarkerArray)
+
+The node only translates messages and parameters and drives one timer; the
+planning is subapf_planner.planner.
+"""
+
+from __future__ import annotations
+
+from collections import deque
+import sys
+
+from geometry_msgs.msg import PoseStamped, Twist, TwistStamped
+from nav_msgs.msg import Odometry
+import numpy as np
+from rcl_interfaces.msg import (
+    FloatingPointRange,
+    IntegerRange,
+    ParameterDescriptor,
+    SetParametersResult,
+)
+import rclpy
+from rclpy.exceptions import ParameterException
+from rclpy.executors import ExternalShutdownException
+from rclpy.node import Node
+from rclpy.qos import qos_profile_sensor_data
+from sensor_msgs.msg import LaserScan
+from std_msgs.msg import String
+from visualization_msgs.msg import MarkerArray
+
+from .config import ConfigError, PlannerConfig, field_specs, from_mapping
+from .conversions import (
+    ScanArrays,
+    cmd_to_msg,
+    markers_from_result,
+    pose_from_odom,
+    scan_from_msg,
+    stamp_to_seconds,
+)
+from .planner import Planner
+
+NODE_NAME = 'subapf_planner'
+#: Odometry poses kept to place each scan at the pose it was taken from.
+POSE_HISTORY = 100
+
+#: Node-only parameters: name -> (default, description, lo, hi).
+NODE_PARAMS: dict[str, tuple] = {
+    'goal_from_parameters': (False, 'Drive to (goal_x, goal_y) at start instead of waiting '
+                             'for goal_pose', None, None),
+    'goal_x': (0.0, 'Goal x in odom_frame [m]', -1e6, 1e6),
+    'goal_y': (0.0, 'Goal y in odom_frame [m]', -1e6, 1e6),
+    'enable_stamped_cmd_vel': (True, 'Publish TwistStamped (true) or Twist (false)',
+                               None, None),
+    'laser_frame': ('base_scan', 'Expected scan frame_id; empty accepts any', None, None),
+    'odom_frame': ('odom', 'Frame of odometry and goals', None, None),
+    'scan_timeout': (1.0, 'Stop when the newest scan is older than this [s]', 0.05, 10.0),
+    'odom_timeout': (0.5, 'Stop when the newest odometry is older than this [s]', 0.05, 10.0),
+    'progress_distance': (0.5, 'Progress checker: required movement [m]', 0.01, 10.0),
+    'progress_timeout': (10.0, 'Progress checker: time allowed for it [s]', 1.0, 600.0),
+}
+
+
+def descriptor(description: str, lo: float | None, hi: float | None, integer: bool = False,
+               choices: tuple[str, ...] | None = None) -> ParameterDescriptor:
+    d = ParameterDescriptor(description=description)
+    if lo is not None and integer:
+        d.integer_range = [IntegerRange(from_value=int(lo), to_value=int(hi), step=1)]
+    elif lo is not None:
+        d.floating_point_range = [FloatingPointRange(from_value=float(lo), to_value=float(hi),
+                                                     step=0.0)]
+    if choices:
+        d.additional_constraints = 'one of: ' + ', '.join(choices)
+    return d
+
+
+class PlannerNode(Node):
+    """Runs the core planner on a timer; every safety decision stops the robot."""
+
+    def __init__(self, **kwargs) -> None:
+        super().__init__(NODE_NAME, **kwargs)
+        for name, (default, text, lo, hi) in NODE_PARAMS.items():
+            self.declare_parameter(name, default, descriptor(text, lo, hi))
+        for f in field_specs():
+            m = f.metadata
+            text = m['description'] + (f' [{m["unit"]}]' if m['unit'] else '')
+            self.declare_parameter(f.name, f.default, descriptor(
+                text, m['lo'], m['hi'], f.type in ('int', int), m['choices']))
+        self.cfg = self._config_from({})      # raises ConfigError on a bad start value
+        self.planner = Planner(self.cfg)
+        self.add_on_set_parameters_callback(self._on_set_parameters)
+
+        stamped = self.get_parameter('enable_stamped_cmd_vel').value
+        self.cmd_pub = self.create_publisher(TwistStamped if stamped else Twist, 'cmd_vel', 10)
+        self.status_pub = self.create_publisher(String, '~/status', 10)
+        self.marker_pub = self.create_publisher(MarkerArray, '~/markers', 10)
+        self.create_subscription(LaserScan, 'scan', self._on_scan, qos_profile_sensor_data)
+        self.create_subscription(Odometry, 'odom', self._on_odom, 10)
+        self.create_subscription(PoseStamped, 'goal_pose', self._on_goal, 10)
+
+        self.scan: ScanArrays | None = None
+        self.scan_time = None
+        self.pose: np.ndarray | None = None
+        self.pose_history: deque = deque(maxlen=POSE_HISTORY)
+        self.odom_time = None
+        self.goal: np.ndarray | None = None
+        self.state = 'idle: no goal'
+        self._progress = (None, None)   # (position, time) of the last progress
+        if self.get_parameter('goal_from_parameters').value:
+            self._set_goal(np.array([self.get_parameter('goal_x').value,
+                                     self.get_parameter('goal_y').value]))
+        self.timer = self.create_timer(self.cfg.period, self._on_timer)
+        self.get_logger().info(
+            f'method={self.cfg.method} d0={self.cfg.danger_distance} m '
+            f'samples={self.cfg.num_samples} R={self.cfg.sample_radius} m '
+            f'rate={self.cfg.planning_frequency} Hz v_max={self.cfg.max_linear_velocity} m/s '
+            f'cmd_vel={"TwistStamped" if stamped else "Twist"}')
+
+    # --- parameters -------------------------------------------------------------------
+    def _config_from(self, changes: dict) -> PlannerConfig:
+        values = {f.name: self.get_parameter(f.name).value for f in field_specs()}
+        values.update({k: v for k, v in changes.items() if k in values})
+        return from_mapping(values)
+
+    def _on_set_parameters(self, params: list) -> SetParametersResult:
+        changes = {p.name: p.value for p in params}
+        try:
+            cfg = self._config_from(changes)
+        except ConfigError as exc:
+            return SetParametersResult(successful=False, reason=str(exc))
+        if 'enable_stamped_cmd_vel' in changes:
+            return SetParametersResult(successful=False,
+                                       reason='enable_stamped_cmd_vel is read at start only')
+        if cfg.planning_frequency != self.cfg.planning_frequency:
+            self.timer.timer_period_ns = int(cfg.period * 1e9)
+        self.cfg = cfg
+        self.planner.cfg = cfg
+        return SetParametersResult(successful=True)
+
+    # --- inputs -----------------------------------------------------------------------
+    def _on_scan(self, msg: LaserScan) -> None:
+        expected = self.get_parameter('laser_frame').value
+        if expected and msg.header.frame_id != expected:
+            self.get_logger().warn(f'scan in frame "{msg.header.frame_id}", expected '
+                                   f'"{expected}": dropped', throttle_duration_sec=5.0)
+            return
+        self.scan = scan_from_msg(msg)
+        self.scan_time = self.get_clock().now()
+
+    def _on_odom(self, msg: Odometry) -> None:
+        pose = pose_from_odom(msg)
+        if not np.all(np.isfinite(pose)):
+            self.get_logger().warn('odometry with a non-finite pose: dropped',
+                                   throttle_duration_sec=5.0)
+            return
+        self.pose = pose
+        self.odom_time = self.get_clock().now()
+        self.pose_history.append((stamp_to_seconds(msg.header.stamp), pose))
+
+    def _on_goal(self, msg: PoseStamped) -> None:
+        frame = self.get_parameter('odom_frame').value
+        goal = np.array([msg.pose.position.x, msg.pose.position.y], dtype=float)
+        if msg.header.frame_id not in ('', frame):
+            self.get_logger().error(f'goal in frame "{msg.header.frame_id}" refused: give it '
+                                    f'in "{frame}"')
+            return
+        if not np.all(np.isfinite(goal)):
+            self.get_logger().error('goal with a non-finite position refused')
+            return
+        self._set_goal(goal)
+
+    def _set_goal(self, goal: np.ndarray) -> None:
+        self.goal = goal
+        self.planner.reset()
+        self._progress = (None, None)
+        self._set_state('driving: new goal')
+        self.get_logger().info(f'goal ({goal[0]:.2f}, {goal[1]:.2f})')
+
+    # --- the planning cycle -----------------------------------------------------------
+    def _age(self, t) -> float:
+        return (self.get_clock().now() - t).nanoseconds * 1e-9
+
+    def _stop(self, state: str) -> None:
+        self.planner.reset()
+        self._publish_cmd(0.0, 0.0)
+        if state != self.state:
+            self.get_logger().warn(f'stopped: {state}', throttle_duration_sec=2.0)
+        self._set_state(state)
+
+    def _on_timer(self) -> None:
+        if self.goal is None:
+            return self._set_state('idle: no goal')
+        if self.scan is None or self.pose is None:
+            missing = 'scan' if self.scan is None else 'odom'
+            return self._set_state(f'waiting: no {missing} yet')
+        if self._age(self.scan_time) > self.get_parameter('scan_timeout').value:
+            return self._stop('stopped: scan is stale')
+        if self._age(self.odom_time) > self.get_parameter('odom_timeout').value:
+            return self._stop('stopped: odometry is stale')
+        if self.state.startswith(('stuck', 'reached')):
+            return self._publish_cmd(0.0, 0.0)
+        s = self.scan
+        result = self.planner.step_scan(self.pose, self.goal, s.ranges, s.angle_min,
+                                        s.angle_increment, s.range_min, s.range_max,
+                                        self._pose_at(s.stamp))
+        cmd = result.command
+        stamp = self.get_clock().now().to_msg()
+        self.marker_pub.publish(markers_from_result(
+            result, self.get_parameter('odom_frame').value, stamp, self.cfg.danger_distance,
+            self.pose))
+        if cmd.status == 'reached':
+            self._stop('reached: goal within tolerance')
+            self.goal = None
+            return
+        if cmd.status in ('no_safe_move', 'goal_in_obstacle', 'invalid_scan', 'invalid_pose',
+                          'invalid_goal'):
+            return self._stop(f'stopped: {cmd.status}')
+        if self._no_progress():
+            return self._stop('stuck: no progress, goal abandoned')
+        self._publish_cmd(cmd.v, cmd.w)
+        self._set_state(f'driving: {cmd.status}')
+
+    def _pose_at(self, stamp: float) -> np.ndarray:
+        """Odometry pose nearest to a scan's stamp (within 0.1 s), else the newest."""
+        if not self.pose_history:
+            return self.pose
+        t, pose = min(self.pose_history, key=lambda tp: abs(tp[0] - stamp))
+        return pose if abs(t - stamp) <= 0.1 else self.pose
+
+    def _no_progress(self) -> bool:
+        pos, t = self._progress
+        now = self.get_clock().now()
+        if pos is None or np.hypot(*(self.pose[:2] - pos)) >= \
+                self.get_parameter('progress_distance').value:
+            self._progress = (self.pose[:2].copy(), now)
+            return False
+        return (now - t).nanoseconds * 1e-9 > self.get_parameter('progress_timeout').value
+
+    def _publish_cmd(self, v: float, w: float) -> None:
+        stamped = self.cmd_pub.msg_type is TwistStamped
+        self.cmd_pub.publish(cmd_to_msg(v, w, stamped, self.get_clock().now().to_msg()))
+
+    def _set_state(self, state: str) -> None:
+        self.state = state
+        self.status_pub.publish(String(data=state))
+
+    def stop_robot(self) -> None:
+        """Zero velocity, e.g. on shutdown."""
+        self._publish_cmd(0.0, 0.0)
+
+
+def main(args: list[str] | None = None) -> int:
+    rclpy.init(args=args)
+    node = None
+    try:
+        node = PlannerNode()
+        rclpy.spin(node)
+    except (KeyboardInterrupt, ExternalShutdownException):
+        pass
+    except (ConfigError, ParameterException) as exc:
+        print(f'subapf-planner: bad parameter: {exc}', file=sys.stderr)
+        return 2
+    finally:
+        if node is not None:
+            if rclpy.ok():
+                node.stop_robot()
+            node.destroy_node()
+        rclpy.try_shutdown()
+    return 0
+
+
+if __name__ == '__main__':
+    sys.exit(main())
+

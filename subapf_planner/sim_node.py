@@ -1,0 +1,137 @@
+"""``sim_node`` (``subapf-sim``): the PyBullet burger stand-in as a ROS 2 node.
+
+Publishes ``/clock`` (rosgraph_msgs/Clock) and stamps everything with
+simulated time, ``scan`` (frame base_scan, sensor-data QoS, 5 Hz), ``odom``
+(odom -> base_footprint, 20 Hz), ``ground_truth`` (nav_msgs/Odometry in the
+world frame) and the run's outcome on ``sim_outcome`` (std_msgs/String:
+reached, collision or timeout; transient-local, published once). Subscribes
+``cmd_vel`` (TwistStamped, or Twist with enable_stamped_cmd_vel:=false).
+Physics advances in steps of 50 ms of simulated time on a wall-clock timer,
+``rate`` times faster than real time. (No /tf: tf2_msgs is not among the
+PyPI ROS wheels; odom carries the same transform.)
+"""
+
+from __future__ import annotations
+
+import sys
+
+from geometry_msgs.msg import Twist, TwistStamped
+from nav_msgs.msg import Odometry
+import numpy as np
+import rclpy
+from rclpy.executors import ExternalShutdownException
+from rclpy.node import Node
+from rclpy.qos import DurabilityPolicy, QoSProfile, qos_profile_sensor_data
+from rosgraph_msgs.msg import Clock
+from sensor_msgs.msg import LaserScan
+from std_msgs.msg import String
+
+from .conversions import cmd_from_msg, odom_to_msg, scan_to_msg, seconds_to_stamp
+from .planner_node import descriptor
+from .simulator import BurgerSim, SimConfig
+from .world import WorldError, load_world
+
+#: Simulated time per timer tick [s]; odometry and /clock go out every tick.
+TICK = 0.05
+SCAN_PERIOD = 0.2
+LATCHED = QoSProfile(depth=1, durability=DurabilityPolicy.TRANSIENT_LOCAL)
+
+PARAMS: dict[str, tuple] = {
+    'world': ('', 'World file (format v1 YAML)', None, None),
+    'rate': (1.0, 'Simulated seconds per wall-clock second', 0.1, 100.0),
+    'enable_stamped_cmd_vel': (True, 'Subscribe TwistStamped (true) or Twist', None, None),
+    'range_noise': (0.01, 'Laser range noise sigma [m]', 0.0, 1.0),
+    'beam_dropout': (0.0, 'Fraction of beams dropped (+inf)', 0.0, 1.0),
+    'scan_dropout': (0.0, 'Fraction of whole scans not published', 0.0, 1.0),
+    'odom_noise': (0.0, 'Relative odometry drift per step', 0.0, 1.0),
+    'cmd_timeout': (0.5, 'Base watchdog: zero velocity after this without cmd_vel [s]',
+                    0.05, 10.0),
+    'seed': (0, 'Random seed of all noise', 0, 2**31 - 1),
+}
+
+
+class SimNode(Node):
+    def __init__(self, **kwargs) -> None:
+        super().__init__('subapf_sim', **kwargs)
+        for name, (default, text, lo, hi) in PARAMS.items():
+            self.declare_parameter(name, default, descriptor(text, lo, hi,
+                                                             isinstance(default, int)
+                                                             and not isinstance(default, bool)))
+        p = {name: self.get_parameter(name).value for name in PARAMS}
+        if not p['world']:
+            raise WorldError('parameter "world" (a world file) is required')
+        self.world = load_world(p['world'])
+        self.sim = BurgerSim(self.world, SimConfig(
+            range_noise=p['range_noise'], beam_dropout=p['beam_dropout'],
+            odom_noise=p['odom_noise'], cmd_timeout=p['cmd_timeout'], seed=p['seed']))
+        self._rng = np.random.default_rng(p['seed'] + 1)
+        self.scan_dropout = p['scan_dropout']
+        self.clock_pub = self.create_publisher(Clock, '/clock', 10)
+        self.scan_pub = self.create_publisher(LaserScan, 'scan', qos_profile_sensor_data)
+        self.odom_pub = self.create_publisher(Odometry, 'odom', 10)
+        self.truth_pub = self.create_publisher(Odometry, 'ground_truth', 10)
+        self.outcome_pub = self.create_publisher(String, 'sim_outcome', LATCHED)
+        cmd_type = TwistStamped if p['enable_stamped_cmd_vel'] else Twist
+        self.create_subscription(cmd_type, 'cmd_vel', self._on_cmd, 10)
+        self.outcome: str | None = None
+        self._next_scan = 0.0
+        self.timer = self.create_timer(TICK / p['rate'], self._on_tick)
+        self.get_logger().info(f'world {self.world.name} from {p["world"]}, rate {p["rate"]}x')
+
+    def _on_cmd(self, msg: Twist | TwistStamped) -> None:
+        self.sim.set_command(*cmd_from_msg(msg))
+
+    def _on_tick(self) -> None:
+        sim = self.sim
+        if self.outcome is None:
+            sim.step(TICK)
+        t = sim.time
+        self.clock_pub.publish(Clock(clock=seconds_to_stamp(t)))
+        pose, twist = sim.odometry()
+        self.odom_pub.publish(odom_to_msg(pose, twist, t))
+        self.truth_pub.publish(odom_to_msg(sim.true_pose(), twist, t, 'world'))
+        if t + 1e-9 >= self._next_scan:
+            self._next_scan += SCAN_PERIOD
+            if self._rng.random() >= self.scan_dropout:
+                s = sim.scan()
+                self.scan_pub.publish(scan_to_msg(s.ranges, s.angle_min, s.angle_increment,
+                                                  s.range_min, s.range_max, t, 'base_scan'))
+        if self.outcome is None:
+            self._check_outcome()
+
+    def _check_outcome(self) -> None:
+        sim = self.sim
+        x, y, _ = sim.true_pose()
+        gx, gy = self.world.goal
+        if np.hypot(x - gx, y - gy) <= self.world.goal_tolerance:
+            self.outcome = 'reached'
+        elif sim.collided:
+            self.outcome = 'collision'
+        elif sim.time >= self.world.time_limit:
+            self.outcome = 'timeout'
+        if self.outcome is not None:
+            self.outcome_pub.publish(String(data=self.outcome))
+            self.get_logger().info(f'outcome: {self.outcome} at t={sim.time:.1f} s')
+
+
+def main(args: list[str] | None = None) -> int:
+    rclpy.init(args=args)
+    node = None
+    try:
+        node = SimNode()
+        rclpy.spin(node)
+    except (KeyboardInterrupt, ExternalShutdownException):
+        pass
+    except (WorldError, ValueError) as exc:
+        print(f'subapf-sim: {exc}', file=sys.stderr)
+        return 2
+    finally:
+        if node is not None:
+            node.sim.close()
+            node.destroy_node()
+        rclpy.try_shutdown()
+    return 0
+
+
+if __name__ == '__main__':
+    sys.exit(main())

@@ -1,0 +1,113 @@
+"""The bringup's own node: sends the goal, watches the outcome, optionally records MCAP."""
+
+from __future__ import annotations
+
+import subprocess
+import time
+
+from geometry_msgs.msg import PoseStamped, TwistStamped
+from nav_msgs.msg import Odometry
+import rclpy
+from rclpy.node import Node
+from rclpy.qos import qos_profile_sensor_data
+from rclpy.serialization import serialize_message
+from rosgraph_msgs.msg import Clock
+from sensor_msgs.msg import LaserScan
+from std_msgs.msg import String
+from visualization_msgs.msg import MarkerArray
+
+from .conversions import pose_from_odom, stamp_to_seconds
+from .recorder import McapRecorder, type_name_of
+from .sim_node import LATCHED
+
+#: topic -> (type, QoS) recorded by --record (absolute names of the bringup graph).
+RECORDED = {
+    '/scan': (LaserScan, qos_profile_sensor_data),
+    '/odom': (Odometry, 10),
+    '/cmd_vel': (TwistStamped, 10),
+    '/goal_pose': (PoseStamped, 10),
+    '/clock': (Clock, 10),
+    '/ground_truth': (Odometry, 10),
+    '/sim_outcome': (String, LATCHED),
+    '/subapf_planner/status': (String, 10),
+    '/subapf_planner/markers': (MarkerArray, 10),
+}
+
+
+class Supervisor:
+    """Owns rclpy in the bringup process for one run."""
+
+    def __init__(self, world, record: str | None, method: str | None = None) -> None:
+        rclpy.init()
+        self.world = world
+        self.method = method
+        self.node = Node('subapf_bringup')
+        self.recorder = McapRecorder(record) if record else None
+        self.path: list = []
+        self.sim_time = 0.0
+        self.outcome: str | None = None
+        self.status = ''
+        self.goal_pub = self.node.create_publisher(PoseStamped, '/goal_pose', 10)
+        self.node.create_subscription(String, '/sim_outcome', self._on_outcome, LATCHED)
+        self.node.create_subscription(Odometry, '/ground_truth', self._on_truth, 10)
+        self.node.create_subscription(String, '/subapf_planner/status', self._on_status, 10)
+        if self.recorder is not None:
+            for topic, (msg_type, qos) in RECORDED.items():
+                self.recorder.add_topic(topic, type_name_of(msg_type))
+                self.node.create_subscription(msg_type, topic, self._recording(topic), qos,
+                                              raw=True)
+
+    def _recording(self, topic: str):
+        def write(data: bytes) -> None:
+            self.recorder.write(topic, data, time.time_ns())
+        return write
+
+    def _on_outcome(self, msg: String) -> None:
+        self.outcome = msg.data
+
+    def _on_truth(self, msg: Odometry) -> None:
+        self.path.append(pose_from_odom(msg))
+        self.sim_time = stamp_to_seconds(msg.header.stamp)
+
+    def _on_status(self, msg: String) -> None:
+        if msg.data.split(':')[0] != self.status.split(':')[0]:
+            print(f'subapf-bringup: planner {msg.data}', flush=True)
+        self.status = msg.data
+
+    def _send_goal(self) -> None:
+        goal = PoseStamped()
+        goal.header.frame_id = 'odom'
+        goal.pose.position.x, goal.pose.position.y = map(float, self.world.goal)
+        goal.pose.orientation.w = 1.0
+        self.goal_pub.publish(goal)
+        if self.recorder is not None:   # our own publication is part of the run
+            self.recorder.write('/goal_pose', serialize_message(goal), time.time_ns())
+
+    def run(self, children: list[subprocess.Popen], timeout: float) -> str:
+        """Spin until the simulator reports an outcome, a child dies, or the timeout."""
+        deadline = time.monotonic() + timeout
+        goal_sent_at = None
+        while time.monotonic() < deadline:
+            rclpy.spin_once(self.node, timeout_sec=0.05)
+            if self.outcome is not None:
+                return self.outcome
+            dead = [c for c in children if c.poll() is not None]
+            if dead:
+                return f'failed: a node exited with code {dead[0].returncode}'
+            # (re)send the goal until the planner has taken it
+            waiting = not self.status or self.status.startswith(('idle', 'waiting'))
+            if self.goal_pub.get_subscription_count() > 0 and waiting and (
+                    goal_sent_at is None or time.monotonic() - goal_sent_at > 1.0):
+                self._send_goal()
+                goal_sent_at = time.monotonic()
+        return 'failed: wall-clock timeout'
+
+    def close(self) -> None:
+        if self.recorder is not None:
+            # drain what is already queued, then finalise the file
+            for _ in range(10):
+                rclpy.spin_once(self.node, timeout_sec=0.01)
+            self.recorder.close()
+        self.node.destroy_node()
+        rclpy.try_shutdown()
+

@@ -1,0 +1,161 @@
+"""Planner node in one process: parameters, safety stops, cmd_vel type (rclpy executor)."""
+
+import math
+import os
+
+from geometry_msgs.msg import PoseStamped, Twist, TwistStamped
+from nav_msgs.msg import Odometry
+import numpy as np
+import pytest
+from rcl_interfaces.msg import ParameterDescriptor
+import rclpy
+from rclpy.executors import SingleThreadedExecutor
+from rclpy.parameter import Parameter
+from rclpy.qos import qos_profile_sensor_data
+from sensor_msgs.msg import LaserScan
+from std_msgs.msg import String
+
+from subapf_planner.conversions import odom_to_msg, scan_to_msg
+from subapf_planner.planner_node import PlannerNode
+
+os.environ['ROS_DOMAIN_ID'] = str(60 + os.getpid() % 40)
+
+
+@pytest.fixture
+def ros():
+    context = rclpy.Context()
+    rclpy.init(context=context)
+    yield context
+    rclpy.try_shutdown(context=context)
+
+
+class Harness:
+    """The node under test plus a peer node that feeds and listens, one executor."""
+
+    def __init__(self, context, **overrides):
+        params = [Parameter(k, value=v) for k, v in overrides.items()]
+        self.node = PlannerNode(context=context, parameter_overrides=params)
+        self.peer = rclpy.create_node('peer', context=context)
+        self.ex = SingleThreadedExecutor(context=context)
+        self.ex.add_node(self.node)
+        self.ex.add_node(self.peer)
+        stamped = self.node.get_parameter('enable_stamped_cmd_vel').value
+        self.cmds = []
+        self.states = []
+        self.peer.create_subscription(TwistStamped if stamped else Twist, 'cmd_vel',
+                                      self.cmds.append, 10)
+        self.peer.create_subscription(String, '/subapf_planner/status',
+                                      lambda m: self.states.append(m.data), 10)
+        self.scan_pub = self.peer.create_publisher(LaserScan, 'scan', qos_profile_sensor_data)
+        self.odom_pub = self.peer.create_publisher(Odometry, 'odom', 10)
+        self.goal_pub = self.peer.create_publisher(PoseStamped, 'goal_pose', 10)
+
+    def spin_until(self, predicate, timeout=5.0):
+        end = self.node.get_clock().now().nanoseconds + timeout * 1e9
+        while self.node.get_clock().now().nanoseconds < end:
+            self.ex.spin_once(timeout_sec=0.02)
+            if predicate():
+                return True
+        return False
+
+    def feed(self, pose=(0.0, 0.0, 0.0), scan=True, odom=True):
+        t = self.node.get_clock().now().nanoseconds * 1e-9
+        if scan:
+            ranges = np.full(360, np.inf)
+            self.scan_pub.publish(scan_to_msg(ranges, 0.0, math.pi / 180, 0.12, 3.5, t,
+                                              'base_scan'))
+        if odom:
+            self.odom_pub.publish(odom_to_msg(np.array(pose), (0.0, 0.0), t))
+
+    def goal(self, x, y, frame='odom'):
+        g = PoseStamped()
+        g.header.frame_id = frame
+        g.pose.position.x, g.pose.position.y = float(x), float(y)
+        self.wait_matched()
+        self.goal_pub.publish(g)
+
+    def wait_matched(self):
+        assert self.spin_until(lambda: self.goal_pub.get_subscription_count() > 0
+                               and self.odom_pub.get_subscription_count() > 0
+                               and len(self.peer.get_publishers_info_by_topic('cmd_vel')) > 0)
+
+    def close(self):
+        self.ex.shutdown()
+        self.node.destroy_node()
+        self.peer.destroy_node()
+
+
+@pytest.fixture
+def harness(ros):
+    made = []
+
+    def make(**overrides):
+        h = Harness(ros, **overrides)
+        made.append(h)
+        return h
+    yield make
+    for h in made:
+        h.close()
+
+
+def test_every_parameter_has_a_descriptor_with_text(harness):
+    node = harness().node
+    for name in node._parameters:
+        if name == 'use_sim_time':
+            continue
+        d: ParameterDescriptor = node.describe_parameter(name)
+        assert d.description, name
+    assert node.describe_parameter('danger_distance').floating_point_range[0].to_value == 2.0
+
+
+def test_runtime_parameter_changes_are_validated(harness):
+    node = harness().node
+    bad = node.set_parameters([Parameter('danger_distance', value=-1.0)])[0]
+    assert not bad.successful
+    bad = node.set_parameters([Parameter('method', value='teleport')])[0]
+    assert not bad.successful and 'method' in bad.reason
+    assert node.get_parameter('method').value == 'subharmonic_sampling'
+    ok = node.set_parameters([Parameter('method', value='harmonic')])[0]
+    assert ok.successful and node.cfg.method == 'harmonic'
+
+
+def test_no_command_before_scan_and_odom_then_drives(harness):
+    h = harness()
+    h.goal(2.0, 0.0)
+    h.spin_until(lambda: False, timeout=0.5)
+    assert h.cmds == []
+    assert any(s.startswith('waiting') for s in h.states)
+    assert h.spin_until(lambda: (h.feed(), any(c.twist.linear.x > 0 for c in h.cmds))[1])
+    assert all(isinstance(c, TwistStamped) for c in h.cmds)
+
+
+def test_stale_odometry_gives_zero_velocity(harness):
+    h = harness(odom_timeout=0.3)
+    h.goal(2.0, 0.0)
+    assert h.spin_until(lambda: (h.feed(), any(c.twist.linear.x > 0 for c in h.cmds))[1])
+    h.cmds.clear()
+    # scans keep coming, odometry stops
+    assert h.spin_until(lambda: (h.feed(odom=False),
+                                 'stopped: odometry is stale' in h.states)[1])
+    assert h.cmds[-1].twist.linear.x == 0.0 and h.cmds[-1].twist.angular.z == 0.0
+
+
+def test_goal_reached_gives_zero_velocity(harness):
+    h = harness()
+    h.goal(0.05, 0.0)
+    assert h.spin_until(lambda: (h.feed(), any(s.startswith('reached') for s in h.states))[1])
+    assert h.cmds and h.cmds[-1].twist.linear.x == 0.0
+
+
+def test_goal_in_another_frame_is_refused(harness):
+    h = harness()
+    h.goal(2.0, 0.0, frame='map')
+    h.spin_until(lambda: (h.feed(), False)[1], timeout=0.6)
+    assert h.node.goal is None and h.cmds == []
+
+
+def test_twist_when_stamped_disabled(harness):
+    h = harness(enable_stamped_cmd_vel=False)
+    h.goal(2.0, 0.0)
+    assert h.spin_until(lambda: (h.feed(), len(h.cmds) > 0)[1])
+    assert isinstance(h.cmds[0], Twist)
