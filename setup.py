@@ -14,6 +14,8 @@ EXECUTABLES = [
     ('bench:main', 'bench', 'subapf-bench'),
     ('figures:main', 'figures', 'subapf-figures'),
     ('perf:main', 'perf', 'subapf-perf'),
+    ('record:main', 'record', 'subapf-record'),
+    ('replay:main', 'replay', 'subapf-replay'),
 ]
 
 setup(

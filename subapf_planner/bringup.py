@@ -70,6 +70,8 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
     p.add_argument('--params', default=None, help='planner params YAML')
     p.add_argument('--rate', type=float, default=1.0, help='simulation speed-up (1 = real time)')
     p.add_argument('--record', default=None, help='write an MCAP bag of the run')
+    p.add_argument('--record-topics', nargs='+', default=None, metavar='TOPIC',
+                   help='topics to record (default: all of supervisor.RECORDED)')
     p.add_argument('--png', default=None, help='trajectory plot (default: WORLD_NAME.png)')
     p.add_argument('--domain-id', type=int, default=None, help='ROS_DOMAIN_ID (default: random)')
     p.add_argument('--seed', type=int, default=0, help='simulator seed')
@@ -110,7 +112,8 @@ def main(argv: list[str] | None = None) -> int:
         KeyboardInterrupt()))
     try:
         children = [start('sim_node', sim_args, env), start('planner_node', planner_args, env)]
-        sup = Supervisor(world, args.record, args.method or load_config(params).method)
+        sup = Supervisor(world, args.record, args.method or load_config(params).method,
+                         args.record_topics)
         outcome = sup.run(children, timeout)
     except KeyboardInterrupt:
         outcome = 'interrupted'

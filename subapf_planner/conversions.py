@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 import math
 
 from builtin_interfaces.msg import Time
@@ -13,20 +12,8 @@ from sensor_msgs.msg import LaserScan
 from std_msgs.msg import ColorRGBA
 from visualization_msgs.msg import Marker, MarkerArray
 
+from .controller import ScanInput
 from .planner import PlanResult
-
-
-@dataclass(frozen=True)
-class ScanArrays:
-    """What the core needs of a LaserScan (ranges as float64, +inf kept)."""
-
-    ranges: np.ndarray
-    angle_min: float
-    angle_increment: float
-    range_min: float
-    range_max: float
-    frame_id: str
-    stamp: float
 
 
 def stamp_to_seconds(stamp: Time) -> float:
@@ -38,11 +25,11 @@ def seconds_to_stamp(t: float) -> Time:
     return Time(sec=ns // 1_000_000_000, nanosec=ns % 1_000_000_000)
 
 
-def scan_from_msg(msg: LaserScan) -> ScanArrays:
-    """LaserScan -> ScanArrays. Geometry is checked later by scan.scan_to_points."""
-    return ScanArrays(np.asarray(msg.ranges, dtype=float), float(msg.angle_min),
-                      float(msg.angle_increment), float(msg.range_min), float(msg.range_max),
-                      msg.header.frame_id, stamp_to_seconds(msg.header.stamp))
+def scan_from_msg(msg: LaserScan) -> ScanInput:
+    """LaserScan -> ScanInput. Geometry is checked later by scan.scan_to_points."""
+    return ScanInput(np.asarray(msg.ranges, dtype=float), float(msg.angle_min),
+                     float(msg.angle_increment), float(msg.range_min), float(msg.range_max),
+                     stamp_to_seconds(msg.header.stamp))
 
 
 def scan_to_msg(ranges: np.ndarray, angle_min: float, angle_increment: float,

@@ -13,7 +13,6 @@ planning is subapf_planner.planner.
 
 from __future__ import annotations
 
-from collections import deque
 import sys
 
 from geometry_msgs.msg import PoseStamped, Twist, TwistStamped
@@ -35,19 +34,16 @@ from std_msgs.msg import String
 from visualization_msgs.msg import MarkerArray
 
 from .config import ConfigError, PlannerConfig, field_specs, from_mapping
+from .controller import PlannerController, Supervision
 from .conversions import (
-    ScanArrays,
     cmd_to_msg,
     markers_from_result,
     pose_from_odom,
     scan_from_msg,
     stamp_to_seconds,
 )
-from .planner import Planner
 
 NODE_NAME = 'subapf_planner'
-#: Odometry poses kept to place each scan at the pose it was taken from.
-POSE_HISTORY = 100
 
 #: Node-only parameters: name -> (default, description, lo, hi).
 NODE_PARAMS: dict[str, tuple] = {
@@ -92,7 +88,6 @@ class PlannerNode(Node):
             self.declare_parameter(f.name, f.default, descriptor(
                 text, m['lo'], m['hi'], f.type in ('int', int), m['choices']))
         self.cfg = self._config_from({})      # raises ConfigError on a bad start value
-        self.planner = Planner(self.cfg)
         self.add_on_set_parameters_callback(self._on_set_parameters)
 
         stamped = self.get_parameter('enable_stamped_cmd_vel').value
@@ -103,14 +98,8 @@ class PlannerNode(Node):
         self.create_subscription(Odometry, 'odom', self._on_odom, 10)
         self.create_subscription(PoseStamped, 'goal_pose', self._on_goal, 10)
 
-        self.scan: ScanArrays | None = None
-        self.scan_time = None
-        self.pose: np.ndarray | None = None
-        self.pose_history: deque = deque(maxlen=POSE_HISTORY)
-        self.odom_time = None
-        self.goal: np.ndarray | None = None
-        self.state = 'idle: no goal'
-        self._progress = (None, None)   # (position, time) of the last progress
+        self.ctl = PlannerController(self.cfg, self._supervision())
+        self._last_state = ''
         if self.get_parameter('goal_from_parameters').value:
             self._set_goal(np.array([self.get_parameter('goal_x').value,
                                      self.get_parameter('goal_y').value]))
@@ -139,18 +128,28 @@ class PlannerNode(Node):
         if cfg.planning_frequency != self.cfg.planning_frequency:
             self.timer.timer_period_ns = int(cfg.period * 1e9)
         self.cfg = cfg
-        self.planner.cfg = cfg
+        if hasattr(self, 'ctl'):
+            self.ctl.cfg = cfg
+            self.ctl.limits = self._supervision(changes)
         return SetParametersResult(successful=True)
 
+    def _supervision(self, changes: dict | None = None) -> Supervision:
+        changes = changes or {}
+        return Supervision(**{f: changes.get(f, self.get_parameter(f).value)
+                              for f in ('scan_timeout', 'odom_timeout', 'progress_distance',
+                                        'progress_timeout')})
+
     # --- inputs -----------------------------------------------------------------------
+    def _now(self) -> float:
+        return self.get_clock().now().nanoseconds * 1e-9
+
     def _on_scan(self, msg: LaserScan) -> None:
         expected = self.get_parameter('laser_frame').value
         if expected and msg.header.frame_id != expected:
             self.get_logger().warn(f'scan in frame "{msg.header.frame_id}", expected '
                                    f'"{expected}": dropped', throttle_duration_sec=5.0)
             return
-        self.scan = scan_from_msg(msg)
-        self.scan_time = self.get_clock().now()
+        self.ctl.update_scan(scan_from_msg(msg), self._now())
 
     def _on_odom(self, msg: Odometry) -> None:
         pose = pose_from_odom(msg)
@@ -158,9 +157,7 @@ class PlannerNode(Node):
             self.get_logger().warn('odometry with a non-finite pose: dropped',
                                    throttle_duration_sec=5.0)
             return
-        self.pose = pose
-        self.odom_time = self.get_clock().now()
-        self.pose_history.append((stamp_to_seconds(msg.header.stamp), pose))
+        self.ctl.update_odom(stamp_to_seconds(msg.header.stamp), pose, self._now())
 
     def _on_goal(self, msg: PoseStamped) -> None:
         frame = self.get_parameter('odom_frame').value
@@ -175,79 +172,26 @@ class PlannerNode(Node):
         self._set_goal(goal)
 
     def _set_goal(self, goal: np.ndarray) -> None:
-        self.goal = goal
-        self.planner.reset()
-        self._progress = (None, None)
-        self._set_state('driving: new goal')
+        self.ctl.set_goal(goal)
         self.get_logger().info(f'goal ({goal[0]:.2f}, {goal[1]:.2f})')
 
     # --- the planning cycle -----------------------------------------------------------
-    def _age(self, t) -> float:
-        return (self.get_clock().now() - t).nanoseconds * 1e-9
-
-    def _stop(self, state: str) -> None:
-        self.planner.reset()
-        self._publish_cmd(0.0, 0.0)
-        if state != self.state:
-            self.get_logger().warn(f'stopped: {state}', throttle_duration_sec=2.0)
-        self._set_state(state)
-
     def _on_timer(self) -> None:
-        if self.goal is None:
-            return self._set_state('idle: no goal')
-        if self.scan is None or self.pose is None:
-            missing = 'scan' if self.scan is None else 'odom'
-            return self._set_state(f'waiting: no {missing} yet')
-        if self._age(self.scan_time) > self.get_parameter('scan_timeout').value:
-            return self._stop('stopped: scan is stale')
-        if self._age(self.odom_time) > self.get_parameter('odom_timeout').value:
-            return self._stop('stopped: odometry is stale')
-        if self.state.startswith(('stuck', 'reached')):
-            return self._publish_cmd(0.0, 0.0)
-        s = self.scan
-        result = self.planner.step_scan(self.pose, self.goal, s.ranges, s.angle_min,
-                                        s.angle_increment, s.range_min, s.range_max,
-                                        self._pose_at(s.stamp))
-        cmd = result.command
-        stamp = self.get_clock().now().to_msg()
-        self.marker_pub.publish(markers_from_result(
-            result, self.get_parameter('odom_frame').value, stamp, self.cfg.danger_distance,
-            self.pose))
-        if cmd.status == 'reached':
-            self._stop('reached: goal within tolerance')
-            self.goal = None
-            return
-        if cmd.status in ('no_safe_move', 'goal_in_obstacle', 'invalid_scan', 'invalid_pose',
-                          'invalid_goal'):
-            return self._stop(f'stopped: {cmd.status}')
-        if self._no_progress():
-            return self._stop('stuck: no progress, goal abandoned')
-        self._publish_cmd(cmd.v, cmd.w)
-        self._set_state(f'driving: {cmd.status}')
-
-    def _pose_at(self, stamp: float) -> np.ndarray:
-        """Odometry pose nearest to a scan's stamp (within 0.1 s), else the newest."""
-        if not self.pose_history:
-            return self.pose
-        t, pose = min(self.pose_history, key=lambda tp: abs(tp[0] - stamp))
-        return pose if abs(t - stamp) <= 0.1 else self.pose
-
-    def _no_progress(self) -> bool:
-        pos, t = self._progress
-        now = self.get_clock().now()
-        if pos is None or np.hypot(*(self.pose[:2] - pos)) >= \
-                self.get_parameter('progress_distance').value:
-            self._progress = (self.pose[:2].copy(), now)
-            return False
-        return (now - t).nanoseconds * 1e-9 > self.get_parameter('progress_timeout').value
+        decision = self.ctl.tick(self._now())
+        if decision.result is not None:
+            self.marker_pub.publish(markers_from_result(
+                decision.result, self.get_parameter('odom_frame').value,
+                self.get_clock().now().to_msg(), self.cfg.danger_distance, self.ctl.pose))
+        if decision.command is not None:
+            self._publish_cmd(*decision.command)
+        if decision.state.startswith(('stopped', 'stuck')) and decision.state != self._last_state:
+            self.get_logger().warn(decision.state)
+        self._last_state = decision.state
+        self.status_pub.publish(String(data=decision.state))
 
     def _publish_cmd(self, v: float, w: float) -> None:
         stamped = self.cmd_pub.msg_type is TwistStamped
         self.cmd_pub.publish(cmd_to_msg(v, w, stamped, self.get_clock().now().to_msg()))
-
-    def _set_state(self, state: str) -> None:
-        self.state = state
-        self.status_pub.publish(String(data=state))
 
     def stop_robot(self) -> None:
         """Zero velocity, e.g. on shutdown."""

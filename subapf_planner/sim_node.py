@@ -86,7 +86,6 @@ class SimNode(Node):
         if self.outcome is None:
             sim.step(TICK)
         t = sim.time
-        self.clock_pub.publish(Clock(clock=seconds_to_stamp(t)))
         pose, twist = sim.odometry()
         self.odom_pub.publish(odom_to_msg(pose, twist, t))
         self.truth_pub.publish(odom_to_msg(sim.true_pose(), twist, t, 'world'))
@@ -96,6 +95,8 @@ class SimNode(Node):
                 s = sim.scan()
                 self.scan_pub.publish(scan_to_msg(s.ranges, s.angle_min, s.angle_increment,
                                                   s.range_min, s.range_max, t, 'base_scan'))
+        # the clock last: a node on sim time then has this tick's data when its timers fire
+        self.clock_pub.publish(Clock(clock=seconds_to_stamp(t)))
         if self.outcome is None:
             self._check_outcome()
 

@@ -9,8 +9,7 @@ from geometry_msgs.msg import PoseStamped, TwistStamped
 from nav_msgs.msg import Odometry
 import rclpy
 from rclpy.node import Node
-from rclpy.qos import qos_profile_sensor_data
-from rclpy.serialization import serialize_message
+from rclpy.qos import QoSProfile, ReliabilityPolicy
 from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import LaserScan
 from std_msgs.msg import String
@@ -20,24 +19,29 @@ from .conversions import pose_from_odom, stamp_to_seconds
 from .recorder import McapRecorder, type_name_of
 from .sim_node import LATCHED
 
+#: Depth of the recording subscriptions: deep enough that a busy recorder loses nothing.
+RECORD_DEPTH = 500
+_SENSOR = QoSProfile(depth=RECORD_DEPTH, reliability=ReliabilityPolicy.BEST_EFFORT)
+_RELIABLE = QoSProfile(depth=RECORD_DEPTH)
 #: topic -> (type, QoS) recorded by --record (absolute names of the bringup graph).
 RECORDED = {
-    '/scan': (LaserScan, qos_profile_sensor_data),
-    '/odom': (Odometry, 10),
-    '/cmd_vel': (TwistStamped, 10),
-    '/goal_pose': (PoseStamped, 10),
-    '/clock': (Clock, 10),
-    '/ground_truth': (Odometry, 10),
+    '/scan': (LaserScan, _SENSOR),
+    '/odom': (Odometry, _RELIABLE),
+    '/cmd_vel': (TwistStamped, _RELIABLE),
+    '/goal_pose': (PoseStamped, _RELIABLE),
+    '/clock': (Clock, _RELIABLE),
+    '/ground_truth': (Odometry, _RELIABLE),
     '/sim_outcome': (String, LATCHED),
-    '/subapf_planner/status': (String, 10),
-    '/subapf_planner/markers': (MarkerArray, 10),
+    '/subapf_planner/status': (String, _RELIABLE),
+    '/subapf_planner/markers': (MarkerArray, _RELIABLE),
 }
 
 
 class Supervisor:
     """Owns rclpy in the bringup process for one run."""
 
-    def __init__(self, world, record: str | None, method: str | None = None) -> None:
+    def __init__(self, world, record: str | None, method: str | None = None,
+                 record_topics: list[str] | None = None) -> None:
         rclpy.init()
         self.world = world
         self.method = method
@@ -53,6 +57,8 @@ class Supervisor:
         self.node.create_subscription(String, '/subapf_planner/status', self._on_status, 10)
         if self.recorder is not None:
             for topic, (msg_type, qos) in RECORDED.items():
+                if record_topics and topic not in record_topics:
+                    continue
                 self.recorder.add_topic(topic, type_name_of(msg_type))
                 self.node.create_subscription(msg_type, topic, self._recording(topic), qos,
                                               raw=True)
@@ -80,8 +86,6 @@ class Supervisor:
         goal.pose.position.x, goal.pose.position.y = map(float, self.world.goal)
         goal.pose.orientation.w = 1.0
         self.goal_pub.publish(goal)
-        if self.recorder is not None:   # our own publication is part of the run
-            self.recorder.write('/goal_pose', serialize_message(goal), time.time_ns())
 
     def run(self, children: list[subprocess.Popen], timeout: float) -> str:
         """Spin until the simulator reports an outcome, a child dies, or the timeout."""

@@ -9,7 +9,8 @@ import sys
 from conftest import REPO
 import pytest
 
-EXECUTABLES = ('planner_node', 'sim_node', 'bringup', 'bench', 'figures', 'perf')
+EXECUTABLES = ('planner_node', 'sim_node', 'bringup', 'bench', 'figures', 'perf', 'record',
+               'replay')
 
 
 @pytest.mark.skipif(shutil.which('colcon', path=str(Path(sys.executable).parent)) is None,

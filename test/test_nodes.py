@@ -151,7 +151,7 @@ def test_goal_in_another_frame_is_refused(harness):
     h = harness()
     h.goal(2.0, 0.0, frame='map')
     h.spin_until(lambda: (h.feed(), False)[1], timeout=0.6)
-    assert h.node.goal is None and h.cmds == []
+    assert h.node.ctl.goal is None and h.cmds == []
 
 
 def test_twist_when_stamped_disabled(harness):
