@@ -16,51 +16,14 @@ import random
 import signal
 import subprocess
 import sys
-import time
 
 import numpy as np
 
 from .config import METHODS, load_config
 from .episode import path_length
 from .paths import default_params_file
+from .processes import ros_env, start, stop
 from .world import WorldError, load_world
-
-CHILD_STOP_TIMEOUT = 5.0
-
-
-def ros_env(domain_id: int) -> dict[str, str]:
-    """The environment for every process of one bringup: DDS on loopback, own domain."""
-    env = dict(os.environ)
-    env['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
-    env['ROS_DOMAIN_ID'] = str(domain_id)
-    env['PYTHONUNBUFFERED'] = '1'
-    return env
-
-
-def start(module: str, ros_args: list[str], env: dict[str, str]) -> subprocess.Popen:
-    """A node as a child process in its own process group (so it can be stopped whole)."""
-    return subprocess.Popen([sys.executable, '-m', f'subapf_planner.{module}', '--ros-args',
-                             *ros_args], env=env, start_new_session=True)
-
-
-def stop(children: list[subprocess.Popen]) -> None:
-    """SIGINT, then SIGTERM, then SIGKILL, to each child's process group."""
-    for sig, wait in ((signal.SIGINT, CHILD_STOP_TIMEOUT), (signal.SIGTERM, 2.0),
-                      (signal.SIGKILL, 2.0)):
-        alive = [c for c in children if c.poll() is None]
-        if not alive:
-            return
-        for c in alive:
-            try:
-                os.killpg(c.pid, sig)
-            except ProcessLookupError:
-                pass
-        deadline = time.monotonic() + wait
-        for c in alive:
-            try:
-                c.wait(timeout=max(0.0, deadline - time.monotonic()))
-            except subprocess.TimeoutExpired:
-                pass
 
 
 def parse_args(argv: list[str] | None) -> argparse.Namespace:

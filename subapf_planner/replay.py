@@ -13,6 +13,7 @@ from __future__ import annotations
 import argparse
 from dataclasses import dataclass
 import math
+import random
 import sys
 
 import numpy as np
@@ -129,6 +130,10 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument('-o', '--output', default=None, help='write the replayed cmd_vel here')
     p.add_argument('--tolerance', type=float, default=1e-3,
                    help='max |dv| [m/s] and |dw| [rad/s] accepted (default 1e-3)')
+    p.add_argument('--through-node', action='store_true',
+                   help='replay through a planner_node process over DDS instead of in-process')
+    p.add_argument('--domain-id', type=int, default=None,
+                   help='ROS_DOMAIN_ID for --through-node (default: random)')
     p.add_argument('--scan-topic', default='/scan')
     p.add_argument('--odom-topic', default='/odom')
     p.add_argument('--goal-topic', default='/goal_pose')
@@ -142,7 +147,12 @@ def main(argv: list[str] | None = None) -> int:
                                 for k in Supervision.__dataclass_fields__})
         names = {'scan': args.scan_topic, 'odom': args.odom_topic, 'goal': args.goal_topic,
                  'cmd_vel': args.cmd_topic}
-        comparison = replay(args.bag, cfg, limits, names)
+        if args.through_node:
+            from .replay_dds import replay_through_node
+            domain = args.domain_id if args.domain_id is not None else random.randint(1, 100)
+            comparison = replay_through_node(args.bag, str(params), names, args.method, domain)
+        else:
+            comparison = replay(args.bag, cfg, limits, names)
     except (BagError, ConfigError) as exc:
         print(f'subapf-replay: {exc}', file=sys.stderr)
         return 2

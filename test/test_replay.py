@@ -98,3 +98,14 @@ def test_foreign_bags_give_clear_errors(tmp_path, capsys):
     assert '/scan is Thing, expected sensor_msgs/msg/LaserScan' in capsys.readouterr().err
     with pytest.raises(BagError, match='not a ROS 2 CDR channel'):
         list(read(bag))
+
+
+def test_replay_through_the_real_node_agrees_with_in_process(capsys):
+    bag = DATA / 'fig6d_big_wall.mcap'
+    assert replay_main([str(bag), '--through-node', '--domain-id', '74',
+                        '--tolerance', '1e-9']) == 0
+    over_dds = capsys.readouterr().out
+    assert replay_main([str(bag), '--tolerance', '1e-9']) == 0
+    in_process = capsys.readouterr().out
+    assert 'first divergence: none' in over_dds
+    assert over_dds.split('\n')[0] == in_process.split('\n')[0]   # same count, none silent

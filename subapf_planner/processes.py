@@ -1,0 +1,51 @@
+"""Child processes of the bringup and the DDS replay: environment, start, stop."""
+
+from __future__ import annotations
+
+import os
+import signal
+import subprocess
+import sys
+import time
+
+CHILD_STOP_TIMEOUT = 5.0
+
+
+def ros_env(domain_id: int) -> dict[str, str]:
+    """The environment for every process of one bringup: DDS on loopback, own domain."""
+    env = dict(os.environ)
+    env['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
+    env['ROS_DOMAIN_ID'] = str(domain_id)
+    env['PYTHONUNBUFFERED'] = '1'
+    return env
+
+
+def start(module: str, ros_args: list[str], env: dict[str, str],
+          quiet: bool = False) -> subprocess.Popen:
+    """A node as a child process in its own process group (so it can be stopped whole).
+
+    ``quiet`` discards its output (its exit code still tells failure).
+    """
+    pipes = dict(stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL) if quiet else {}
+    return subprocess.Popen([sys.executable, '-m', f'subapf_planner.{module}', '--ros-args',
+                             *ros_args], env=env, start_new_session=True, **pipes)
+
+
+def stop(children: list[subprocess.Popen]) -> None:
+    """SIGINT, then SIGTERM, then SIGKILL, to each child's process group."""
+    for sig, wait in ((signal.SIGINT, CHILD_STOP_TIMEOUT), (signal.SIGTERM, 2.0),
+                      (signal.SIGKILL, 2.0)):
+        alive = [c for c in children if c.poll() is None]
+        if not alive:
+            return
+        for c in alive:
+            try:
+                os.killpg(c.pid, sig)
+            except ProcessLookupError:
+                pass
+        deadline = time.monotonic() + wait
+        for c in alive:
+            try:
+                c.wait(timeout=max(0.0, deadline - time.monotonic()))
+            except subprocess.TimeoutExpired:
+                pass
