@@ -14,6 +14,7 @@ EXECUTABLES = [
     ('bench:main', 'bench', 'subapf-bench'),
     ('figures:main', 'figures', 'subapf-figures'),
     ('perf:main', 'perf', 'subapf-perf'),
+    ('perf_nodes:main', 'nodeperf', 'subapf-nodeperf'),
     ('record:main', 'record', 'subapf-record'),
     ('replay:main', 'replay', 'subapf-replay'),
 ]

@@ -14,6 +14,7 @@ from visualization_msgs.msg import Marker, MarkerArray
 
 from .controller import ScanInput
 from .planner import PlanResult
+from .scan import voxel_downsample
 
 
 def stamp_to_seconds(stamp: Time) -> float:
@@ -118,12 +119,14 @@ def _points(xy: np.ndarray) -> list[Point]:
 
 
 def markers_from_result(result: PlanResult, frame: str, stamp: Time,
-                        danger_distance: float, position: np.ndarray) -> MarkerArray:
-    """Obstacle points, raw next move point, samples coloured by score, chosen point and
-    the danger circle around the robot, for RViz or Foxglove."""
+                        danger_distance: float, position: np.ndarray,
+                        voxel: float = 0.05) -> MarkerArray:
+    """Obstacle points (voxel-downsampled, as the repulsion sees them), raw next move
+    point, samples coloured by score, chosen point and the danger circle around the
+    robot, for RViz or Foxglove."""
     out = MarkerArray()
     obs = _marker('obstacles', 0, Marker.POINTS, frame, stamp, 0.03, (0.9, 0.2, 0.2, 1.0))
-    obs.points = _points(result.obstacles)
+    obs.points = _points(voxel_downsample(result.obstacles, voxel))
     out.markers.append(obs)
     for ns, point, rgba in (('raw_point', result.raw_point, (1.0, 0.6, 0.0, 1.0)),
                             ('chosen_point', result.chosen_point, (0.0, 0.8, 0.0, 1.0))):

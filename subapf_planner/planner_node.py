@@ -53,6 +53,8 @@ NODE_PARAMS: dict[str, tuple] = {
     'goal_y': (0.0, 'Goal y in odom_frame [m]', -1e6, 1e6),
     'enable_stamped_cmd_vel': (True, 'Publish TwistStamped (true) or Twist (false)',
                                None, None),
+    'publish_markers': (True, 'Publish ~/markers every cycle (costs about 1 ms of CPU)',
+                        None, None),
     'laser_frame': ('base_scan', 'Expected scan frame_id; empty accepts any', None, None),
     'odom_frame': ('odom', 'Frame of odometry and goals', None, None),
     'scan_timeout': (1.0, 'Stop when the newest scan is older than this [s]', 0.05, 10.0),
@@ -177,21 +179,23 @@ class PlannerNode(Node):
 
     # --- the planning cycle -----------------------------------------------------------
     def _on_timer(self) -> None:
-        decision = self.ctl.tick(self._now())
-        if decision.result is not None:
+        tick = self.get_clock().now()
+        decision = self.ctl.tick(tick.nanoseconds * 1e-9)
+        if decision.command is not None:   # the command first, stamped with the tick time
+            self._publish_cmd(*decision.command, stamp=tick.to_msg())
+        if decision.result is not None and self.get_parameter('publish_markers').value:
             self.marker_pub.publish(markers_from_result(
-                decision.result, self.get_parameter('odom_frame').value,
-                self.get_clock().now().to_msg(), self.cfg.danger_distance, self.ctl.pose))
-        if decision.command is not None:
-            self._publish_cmd(*decision.command)
+                decision.result, self.get_parameter('odom_frame').value, tick.to_msg(),
+                self.cfg.danger_distance, self.ctl.pose, self.cfg.voxel_size))
         if decision.state.startswith(('stopped', 'stuck')) and decision.state != self._last_state:
             self.get_logger().warn(decision.state)
         self._last_state = decision.state
         self.status_pub.publish(String(data=decision.state))
 
-    def _publish_cmd(self, v: float, w: float) -> None:
+    def _publish_cmd(self, v: float, w: float, stamp=None) -> None:
         stamped = self.cmd_pub.msg_type is TwistStamped
-        self.cmd_pub.publish(cmd_to_msg(v, w, stamped, self.get_clock().now().to_msg()))
+        self.cmd_pub.publish(cmd_to_msg(v, w, stamped,
+                                        stamp or self.get_clock().now().to_msg()))
 
     def stop_robot(self) -> None:
         """Zero velocity, e.g. on shutdown."""

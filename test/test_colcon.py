@@ -9,7 +9,8 @@ import sys
 from conftest import REPO
 import pytest
 
-EXECUTABLES = ('planner_node', 'sim_node', 'bringup', 'bench', 'figures', 'perf', 'record',
+EXECUTABLES = ('planner_node', 'sim_node', 'bringup', 'bench', 'figures', 'perf', 'nodeperf',
+               'record',
                'replay')
 
 

@@ -46,3 +46,13 @@ def test_bad_params_file(tmp_path):
     bad.write_text('subapf_planner:\n  ros__parameters:\n    goal_tolerance: -3\n')
     with pytest.raises(ConfigError, match='goal_tolerance'):
         load_config(bad)
+
+
+def test_yaml_lists_every_node_parameter_with_its_default():
+    from subapf_planner.planner_node import NODE_PARAMS
+    params = yaml.safe_load(PARAMS.read_text())['subapf_planner']['ros__parameters']
+    for name, (default, *_rest) in NODE_PARAMS.items():
+        assert name in params, f'{name} missing from config/planner.yaml'
+        assert params[name] == default, name
+    core = {f.name for f in dataclasses.fields(PlannerConfig)}
+    assert set(params) == core | set(NODE_PARAMS)
