@@ -23,6 +23,8 @@ from .planner import Planner, PlanResult
 POSE_HISTORY = 100
 #: A scan is placed with the odometry pose nearest its stamp, if within this [s].
 POSE_MATCH = 0.1
+#: Goals closer than this to the current one are the same goal [m].
+SAME_GOAL = 1e-3
 #: Core statuses that stop the robot.
 STOP_STATUSES = ('no_safe_move', 'goal_in_obstacle', 'invalid_scan', 'invalid_pose',
                  'invalid_goal')
@@ -82,11 +84,19 @@ class PlannerController:
     def cfg(self, cfg: PlannerConfig) -> None:
         self.planner.cfg = cfg
 
-    def set_goal(self, goal: np.ndarray) -> None:
-        self.goal = np.asarray(goal, float).copy()
+    def set_goal(self, goal: np.ndarray) -> bool:
+        """A new goal resets the planner; the goal being driven to, sent again while
+        driving, does not (a stuck or stopped robot retries it).
+        Returns whether the goal was new."""
+        goal = np.asarray(goal, float)
+        if self.goal is not None and self.state.startswith('driving') \
+                and np.hypot(*(goal - self.goal)) < SAME_GOAL:
+            return False
+        self.goal = goal.copy()
         self.planner.reset()
         self._progress = None
         self.state = 'driving: new goal'
+        return True
 
     def update_scan(self, scan: ScanInput, now: float) -> None:
         self.scan, self.scan_time = scan, now

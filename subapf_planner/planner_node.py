@@ -174,8 +174,8 @@ class PlannerNode(Node):
         self._set_goal(goal)
 
     def _set_goal(self, goal: np.ndarray) -> None:
-        self.ctl.set_goal(goal)
-        self.get_logger().info(f'goal ({goal[0]:.2f}, {goal[1]:.2f})')
+        if self.ctl.set_goal(goal):
+            self.get_logger().info(f'goal ({goal[0]:.2f}, {goal[1]:.2f})')
 
     # --- the planning cycle -----------------------------------------------------------
     def _on_timer(self) -> None:

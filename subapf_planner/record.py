@@ -37,9 +37,11 @@ class RecordNode(Node):
             if topic not in self.wanted or topic in self.subscribed or not types:
                 continue
             offered = self.get_publishers_info_by_topic(topic)
+            if not offered:
+                continue   # known from a subscriber only: wait to see the publishers' QoS
             best_effort = any(i.qos_profile.reliability == ReliabilityPolicy.BEST_EFFORT
                               for i in offered)
-            latched = offered and all(i.qos_profile.durability
+            latched = all(i.qos_profile.durability
                                       == DurabilityPolicy.TRANSIENT_LOCAL for i in offered)
             qos = QoSProfile(depth=DEPTH, reliability=ReliabilityPolicy.BEST_EFFORT
                              if best_effort else ReliabilityPolicy.RELIABLE,

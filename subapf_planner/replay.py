@@ -32,16 +32,24 @@ CMD_TYPES = ('geometry_msgs/msg/TwistStamped', 'geometry_msgs/msg/Twist')
 
 @dataclass(frozen=True)
 class Comparison:
-    """Recorded vs replayed commands: times [s], (v, w) arrays (n, 2), NaN = none."""
+    """Recorded vs replayed commands: times [s], (v, w) arrays (n, 2), NaN = none.
+
+    ``skipped`` leading commands were published before the bag holds a scan, an
+    odometry message and a goal (the recording started after the node did):
+    they cannot be replayed and are left out of the comparison.
+    """
 
     times: np.ndarray
     recorded: np.ndarray
     replayed: np.ndarray
+    skipped: int = 0
 
     @property
     def diff(self) -> np.ndarray:
         d = np.abs(self.replayed - self.recorded)
-        return np.where(np.isnan(d), np.inf, d)
+        d = np.where(np.isnan(d), np.inf, d)
+        d[:self.skipped] = 0.0
+        return d
 
     def first_divergence(self, tol_v: float, tol_w: float) -> float | None:
         bad = (self.diff[:, 0] > tol_v) | (self.diff[:, 1] > tol_w)
@@ -87,6 +95,7 @@ def replay(path: str, cfg: PlannerConfig, limits: Supervision,
     events.sort(key=lambda e: (e[0], e[1]))
     ctl = PlannerController(cfg, limits)
     times, recorded, replayed = [], [], []
+    skipped = 0
     for t, _, r, payload in events:
         if r == 'scan':
             ctl.update_scan(payload, t)
@@ -97,13 +106,19 @@ def replay(path: str, cfg: PlannerConfig, limits: Supervision,
             if np.all(np.isfinite(payload)):
                 ctl.set_goal(payload)
         else:
-            decision = ctl.tick(t)
+            if skipped == len(replayed) and (ctl.scan is None or ctl.pose is None
+                                             or ctl.goal is None):
+                skipped += 1
+                decision = ctl.tick(t)
+                ctl.planner.previous = payload   # the node's state after what it published
+            else:
+                decision = ctl.tick(t)
             times.append(t)
             recorded.append(payload)
             replayed.append(decision.command if decision.command is not None
                             else (math.nan, math.nan))
     return Comparison(np.asarray(times), np.asarray(recorded, float).reshape(-1, 2),
-                      np.asarray(replayed, float).reshape(-1, 2))
+                      np.asarray(replayed, float).reshape(-1, 2), skipped)
 
 
 def write_commands(out: str, comparison: Comparison) -> None:
@@ -157,14 +172,15 @@ def main(argv: list[str] | None = None) -> int:
         print(f'subapf-replay: {exc}', file=sys.stderr)
         return 2
     n = len(comparison.times)
-    if n == 0:
+    if n == comparison.skipped:
         print(f'subapf-replay: {args.bag}: no {args.cmd_topic} messages to compare',
               file=sys.stderr)
         return 2
-    d = comparison.diff
+    d = comparison.diff[comparison.skipped:]
     finite = np.isfinite(d).all(axis=1)
     first = comparison.first_divergence(args.tolerance, args.tolerance)
-    print(f'commands compared: {n} (replay silent on {n - int(finite.sum())})')
+    print(f'commands compared: {len(d)} (replay silent on {len(d) - int(finite.sum())}; '
+          f'{comparison.skipped} before the bag had scan, odom and goal, not replayable)')
     if finite.any():
         print(f'|dv| max {d[finite, 0].max():.6f} mean {d[finite, 0].mean():.6f} m/s; '
               f'|dw| max {d[finite, 1].max():.6f} mean {d[finite, 1].mean():.6f} rad/s')

@@ -51,7 +51,8 @@ class Supervisor:
         self.sim_time = 0.0
         self.outcome: str | None = None
         self.status = ''
-        self.goal_pub = self.node.create_publisher(PoseStamped, '/goal_pose', 10)
+        # latched, so a recorder that starts late still gets the goal
+        self.goal_pub = self.node.create_publisher(PoseStamped, '/goal_pose', LATCHED)
         self.node.create_subscription(String, '/sim_outcome', self._on_outcome, LATCHED)
         self.node.create_subscription(Odometry, '/ground_truth', self._on_truth, 10)
         self.node.create_subscription(String, '/subapf_planner/status', self._on_status, 10)
