@@ -101,13 +101,20 @@ class PlannerController:
     def update_scan(self, scan: ScanInput, now: float) -> None:
         self.scan, self.scan_time = scan, now
 
-    def update_odom(self, stamp: float, pose: np.ndarray, now: float) -> None:
+    def update_odom(self, stamp: float, pose: np.ndarray, now: float) -> bool:
+        """Take an odometry pose; returns False when its stamp went back in time (the
+        pose history is then cleared: a restarted simulator or driver)."""
+        jumped = bool(self.poses) and stamp < self.poses[-1][0]
+        if jumped:
+            self.poses.clear()
         self.pose, self.odom_time = np.asarray(pose, float), now
         self.poses.append((stamp, self.pose))
+        return not jumped
 
     def pose_at(self, stamp: float) -> np.ndarray:
-        """Odometry pose nearest ``stamp`` (within POSE_MATCH), else the newest."""
-        t, pose = min(self.poses, key=lambda tp: abs(tp[0] - stamp))
+        """Odometry pose nearest ``stamp`` (within POSE_MATCH; the newest on a tie),
+        else the newest."""
+        t, pose = min(reversed(self.poses), key=lambda tp: abs(tp[0] - stamp))
         return pose if abs(t - stamp) <= POSE_MATCH else self.pose
 
     def _stop(self, state: str) -> Decision:

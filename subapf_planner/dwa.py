@@ -60,15 +60,17 @@ def rollout(pose: ArrayLike, v: NDArray, w: NDArray, horizon: float) -> NDArray[
 
 def dwa_command(pose: ArrayLike, goal: ArrayLike, previous: tuple[float, float],
                 obstacles: ArrayLike, cfg: PlannerConfig) -> DwaResult:
-    """Best admissible (v, w) of the dynamic window around ``previous``."""
+    """Best admissible (v, w) of the dynamic window around ``previous`` (clipped to the
+    velocity limits, so a ``previous`` outside them cannot yield a command outside)."""
     v0, w0 = previous
     dt = cfg.period
-    v_lo = max(0.0, v0 - cfg.max_linear_acceleration * dt)
-    v_hi = min(cfg.max_linear_velocity, v0 + cfg.max_linear_acceleration * dt)
-    w_lo = max(-cfg.max_angular_velocity, w0 - cfg.max_angular_acceleration * dt)
-    w_hi = min(cfg.max_angular_velocity, w0 + cfg.max_angular_acceleration * dt)
-    vs, ws = np.meshgrid(np.linspace(v_lo, max(v_lo, v_hi), cfg.dwa_v_samples),
-                         np.linspace(w_lo, max(w_lo, w_hi), cfg.dwa_w_samples))
+    v_max, w_max = cfg.max_linear_velocity, cfg.max_angular_velocity
+    v_lo, v_hi = np.clip([v0 - cfg.max_linear_acceleration * dt,
+                          v0 + cfg.max_linear_acceleration * dt], 0.0, v_max)
+    w_lo, w_hi = np.clip([w0 - cfg.max_angular_acceleration * dt,
+                          w0 + cfg.max_angular_acceleration * dt], -w_max, w_max)
+    vs, ws = np.meshgrid(np.linspace(v_lo, v_hi, cfg.dwa_v_samples),
+                         np.linspace(w_lo, w_hi, cfg.dwa_w_samples))
     vs, ws = vs.ravel(), ws.ravel()
     paths = rollout(pose, vs, ws, cfg.dwa_horizon)
     k, steps, _ = paths.shape

@@ -42,6 +42,7 @@ from .conversions import (
     scan_from_msg,
     stamp_to_seconds,
 )
+from .scan import geometry_warning
 
 NODE_NAME = 'subapf_planner'
 
@@ -151,6 +152,10 @@ class PlannerNode(Node):
             self.get_logger().warn(f'scan in frame "{msg.header.frame_id}", expected '
                                    f'"{expected}": dropped', throttle_duration_sec=5.0)
             return
+        problem = geometry_warning(len(msg.ranges), msg.angle_min, msg.angle_max,
+                                   msg.angle_increment)
+        if problem:
+            self.get_logger().warn(f'scan header: {problem}', throttle_duration_sec=5.0)
         self.ctl.update_scan(scan_from_msg(msg), self._now())
 
     def _on_odom(self, msg: Odometry) -> None:
@@ -159,7 +164,9 @@ class PlannerNode(Node):
             self.get_logger().warn('odometry with a non-finite pose: dropped',
                                    throttle_duration_sec=5.0)
             return
-        self.ctl.update_odom(stamp_to_seconds(msg.header.stamp), pose, self._now())
+        if not self.ctl.update_odom(stamp_to_seconds(msg.header.stamp), pose, self._now()):
+            self.get_logger().warn('odometry stamp went back in time: pose history cleared',
+                                   throttle_duration_sec=5.0)
 
     def _on_goal(self, msg: PoseStamped) -> None:
         frame = self.get_parameter('odom_frame').value

@@ -62,6 +62,19 @@ def scan_to_points(ranges: ArrayLike, angle_min: float, angle_increment: float,
     return np.column_stack((x + c * bx - s * by, y + s * bx + c * by))
 
 
+def geometry_warning(n: int, angle_min: float, angle_max: float,
+                     angle_increment: float) -> str | None:
+    """Why a scan's header is suspicious, or None. Such a scan is still used, with beam
+    i at angle_min + i * angle_increment (LDS-02 beam counts vary from scan to scan)."""
+    if n > 1 and angle_increment > 0.0 and n * angle_increment > 2.0 * math.pi + angle_increment:
+        return f'{n} beams of {angle_increment:.5f} rad cover more than a full turn'
+    if n > 1 and angle_increment > 0.0 and math.isfinite(angle_max):
+        expected = int(round((angle_max - angle_min) / angle_increment)) + 1
+        if abs(expected - n) > 1:
+            return f'{n} ranges, but angle_min/angle_max/angle_increment describe {expected}'
+    return None
+
+
 def voxel_downsample(points: ArrayLike, voxel: float) -> NDArray[np.float64]:
     """One point per square cell of side ``voxel`` [m] (the centroid of the cell's points).
 

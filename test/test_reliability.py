@@ -1,0 +1,239 @@
+"""Bad input: fuzzing the core and the node, and each kind of malformed message."""
+
+import math
+import os
+
+from geometry_msgs.msg import PoseStamped
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+from hypothesis.extra.numpy import arrays
+from nav_msgs.msg import Odometry
+import numpy as np
+import pytest
+import rclpy
+from rclpy.parameter import Parameter
+from sensor_msgs.msg import LaserScan
+
+from subapf_planner.command import forward_blocked
+from subapf_planner.config import METHODS, PlannerConfig
+from subapf_planner.controller import PlannerController, ScanInput
+from subapf_planner.planner import Planner, plan
+from subapf_planner.planner_node import PlannerNode
+from subapf_planner.scan import geometry_warning
+
+CFG = PlannerConfig()
+weird = st.one_of(st.floats(-10, 10), st.sampled_from([math.nan, math.inf, -math.inf, 0.0]))
+coord = st.floats(-4.0, 4.0)
+points = arrays(np.float64, st.tuples(st.integers(0, 60), st.just(2)),
+                elements=st.one_of(st.floats(-3, 3), st.sampled_from([math.nan, math.inf])))
+
+
+def check_command(cmd, pose, obstacles, cfg=CFG):
+    assert math.isfinite(cmd.v) and math.isfinite(cmd.w)
+    assert 0.0 <= cmd.v <= cfg.max_linear_velocity + 1e-12
+    assert abs(cmd.w) <= cfg.max_angular_velocity + 1e-12
+    obs = np.asarray(obstacles, float).reshape(-1, 2)
+    obs = obs[np.all(np.isfinite(obs), axis=1)]
+    if np.all(np.isfinite(pose)) and forward_blocked(pose, obs, cfg):
+        assert cmd.v == 0.0   # never forward into what it sees inside the danger distance
+
+
+@given(method=st.sampled_from(METHODS), x=coord, y=coord, yaw=st.floats(-7, 7), gx=weird,
+       gy=weird, obstacles=points, v0=st.floats(-1, 1), w0=st.floats(-5, 5))
+@settings(max_examples=2000, deadline=None)
+def test_fuzz_core_plan(method, x, y, yaw, gx, gy, obstacles, v0, w0):
+    cfg = CFG.replace(method=method)
+    result = plan(cfg, (x, y, yaw), (gx, gy), obstacles, (v0, w0))
+    check_command(result.command, (x, y, yaw), obstacles, cfg)
+    if not (math.isfinite(gx) and math.isfinite(gy)):
+        assert result.command.status == 'invalid_goal'
+
+
+@given(ranges=arrays(np.float64, st.integers(0, 400), elements=weird),
+       angle_min=weird, inc=weird, rmin=weird, rmax=weird, pose=st.tuples(coord, coord, weird))
+@settings(max_examples=1000, deadline=None)
+def test_fuzz_core_scans(ranges, angle_min, inc, rmin, rmax, pose):
+    result = Planner(CFG).step_scan(pose, (2.0, 2.0), ranges, angle_min, inc, rmin, rmax)
+    check_command(result.command, pose, result.obstacles)
+
+
+# --- the node, in one process: callbacks and timer called directly -------------------------
+
+@pytest.fixture(scope='module')
+def node():
+    os.environ['ROS_DOMAIN_ID'] = str(20 + os.getpid() % 30)
+    context = rclpy.Context()
+    rclpy.init(context=context)
+    n = PlannerNode(context=context, parameter_overrides=[Parameter('scan_timeout', value=10.0),
+                                                          Parameter('odom_timeout', value=10.0)])
+    yield n
+    n.destroy_node()
+    rclpy.try_shutdown(context=context)
+
+
+class Captured:
+    def __init__(self, node):
+        self.node, self.cmds, self.decisions = node, [], []
+        node._publish_cmd = lambda v, w, stamp=None: self.cmds.append((v, w))
+        tick = PlannerController.tick.__get__(node.ctl)   # the unwrapped method
+
+        def recording_tick(now):
+            d = tick(now)
+            self.decisions.append(d)
+            return d
+        node.ctl.tick = recording_tick
+
+
+def scan_msg(ranges, angle_min, inc, rmin, rmax, frame, angle_max=None):
+    m = LaserScan()
+    m.header.frame_id = frame
+    m.ranges = [float(r) for r in ranges]
+    m.angle_min, m.angle_increment, m.range_min, m.range_max = angle_min, inc, rmin, rmax
+    m.angle_max = angle_max if angle_max is not None else angle_min + inc * (len(ranges) - 1)
+    return m
+
+
+def odom_msg(x, y, q, cov=0.0, stamp=0):
+    m = Odometry()
+    m.header.stamp.sec = stamp
+    m.pose.pose.position.x, m.pose.pose.position.y = x, y
+    o = m.pose.pose.orientation
+    o.x, o.y, o.z, o.w = q
+    m.pose.covariance = [cov] * 36
+    return m
+
+
+def goal_msg(x, y, frame='odom'):
+    g = PoseStamped()
+    g.header.frame_id = frame
+    g.pose.position.x, g.pose.position.y = x, y
+    return g
+
+
+@given(ranges=st.lists(weird, max_size=400), angle_min=weird, inc=weird, rmin=weird,
+       rmax=weird, frame=st.sampled_from(['base_scan', 'laser', '']),
+       x=st.one_of(coord, st.just(math.nan)), y=coord,
+       q=st.tuples(weird, weird, weird, weird), cov=weird,
+       goal=st.one_of(st.none(), st.tuples(weird, weird, st.sampled_from(['odom', 'map']))))
+@settings(max_examples=1000, deadline=None,
+          suppress_health_check=[HealthCheck.function_scoped_fixture])
+def test_fuzz_node(node, ranges, angle_min, inc, rmin, rmax, frame, x, y, q, cov, goal):
+    cap = Captured(node)
+    if goal is not None:
+        node._on_goal(goal_msg(*goal))
+    elif node.ctl.goal is None:
+        node._on_goal(goal_msg(2.5, 1.0))
+    node._on_scan(scan_msg(ranges, angle_min, inc, rmin, rmax, frame))
+    node._on_odom(odom_msg(x, y, q, cov))
+    node._on_timer()
+    for (v, w), d in zip(cap.cmds, [d for d in cap.decisions if d.command], strict=True):
+        assert (v, w) == d.command
+        cmd = type('C', (), {'v': v, 'w': w})
+        obstacles = d.result.obstacles if d.result is not None else np.zeros((0, 2))
+        check_command(cmd, node.ctl.pose, obstacles)
+
+
+# --- each kind of bad input, with its defined result ------------------------------------------
+
+def drive(node, scan, pose=(0.0, 0.0), goal=(3.0, 0.0), q=(0, 0, 0, 1), stamp=0):
+    cap = Captured(node)
+    node.ctl.goal = None
+    node._on_goal(goal_msg(*goal))
+    node._on_scan(scan)
+    node._on_odom(odom_msg(*pose, q, stamp=stamp))
+    node._on_timer()
+    return cap.decisions[-1]
+
+
+FREE = [math.inf] * 360
+
+
+def test_wrong_frame_scan_is_dropped(node):
+    node.ctl.scan = None
+    d = drive(node, scan_msg(FREE, 0.0, math.pi / 180, 0.12, 3.5, 'laser'))
+    assert d.command is None and d.state == 'waiting: no scan yet'
+
+
+@pytest.mark.parametrize('inc', [0.0, -0.01, math.nan])
+def test_bad_angle_increment_stops(node, inc):
+    d = drive(node, scan_msg([1.0] * 10, 0.0, inc, 0.12, 3.5, 'base_scan'))
+    assert d.command == (0.0, 0.0) and d.state == 'stopped: invalid_scan'
+
+
+def test_length_mismatch_and_intensities_do_not_matter(node):
+    msg = scan_msg(FREE, 0.0, math.pi / 180, 0.12, 3.5, 'base_scan', angle_max=1.0)
+    msg.intensities = [1.0, 2.0]
+    assert geometry_warning(360, 0.0, 1.0, math.pi / 180) is not None
+    d = drive(node, msg)
+    assert d.state.startswith('driving') and d.command[0] >= 0.0
+
+
+def test_all_inf_and_empty_scans_are_open_space(node):
+    assert drive(node, scan_msg(FREE, 0.0, math.pi / 180, 0.12, 3.5, 'base_scan')
+                 ).state.startswith('driving')
+    assert drive(node, scan_msg([], 0.0, 0.0, 0.12, 3.5, 'base_scan')).state.startswith(
+        'driving')
+
+
+def test_obstacle_ahead_inside_danger_distance_zeroes_forward_speed(node):
+    ranges = list(FREE)
+    ranges[0] = 0.2 + 0.032   # 0.2 m ahead of base_footprint
+    d = drive(node, scan_msg(ranges, 0.0, math.pi / 180, 0.12, 3.5, 'base_scan'))
+    assert d.command is None or d.command[0] == 0.0
+
+
+def test_nan_pose_dropped_and_quaternion_normalised(node):
+    node.ctl.pose = None
+    d = drive(node, scan_msg(FREE, 0.0, math.pi / 180, 0.12, 3.5, 'base_scan'),
+              pose=(math.nan, 0.0))
+    assert d.command is None and d.state == 'waiting: no odom yet'
+    drive(node, scan_msg(FREE, 0.0, math.pi / 180, 0.12, 3.5, 'base_scan'),
+          q=(0.0, 0.0, 2.0, 2.0))   # |q| = 2.8: yaw pi/2 after normalising
+    assert node.ctl.pose[2] == pytest.approx(math.pi / 2)
+
+
+def test_odometry_time_going_back_clears_history():
+    ctl = PlannerController(CFG)
+    assert ctl.update_odom(5.0, np.zeros(3), 5.0)
+    assert not ctl.update_odom(1.0, np.ones(3), 5.1)
+    assert len(ctl.poses) == 1
+
+
+@pytest.mark.parametrize('goal, frame', [((math.nan, 1.0), 'odom'), ((1.0, 1.0), 'map')])
+def test_bad_goals_are_refused(node, goal, frame):
+    node.ctl.goal = None
+    node._on_goal(goal_msg(*goal, frame=frame))
+    assert node.ctl.goal is None
+
+
+def test_goal_inside_obstacle_stops_with_reason():
+    ctl = PlannerController(CFG)
+    ctl.set_goal(np.array([1.0, 0.0]))
+    ranges = np.full(360, np.inf)
+    ranges[0] = 1.032   # a return exactly at the goal
+    ctl.update_scan(ScanInput(ranges, 0.0, math.pi / 180, 0.12, 3.5, 0.0), 0.0)
+    ctl.update_odom(0.0, np.zeros(3), 0.0)
+    d = ctl.tick(0.0)
+    assert d.command == (0.0, 0.0) and d.state == 'stopped: goal_in_obstacle'
+
+
+def test_goal_equal_to_start_is_reached_at_once():
+    ctl = PlannerController(CFG)
+    ctl.set_goal(np.array([0.0, 0.0]))
+    ctl.update_scan(ScanInput(np.full(360, np.inf), 0.0, math.pi / 180, 0.12, 3.5, 0.0), 0.0)
+    ctl.update_odom(0.0, np.zeros(3), 0.0)
+    assert ctl.tick(0.0).state.startswith('reached') and ctl.goal is None
+
+
+def test_goal_behind_a_wall_without_progress_becomes_stuck():
+    ctl = PlannerController(CFG.replace(method='traditional'))
+    ctl.limits = type(ctl.limits)(progress_timeout=2.0)
+    ctl.set_goal(np.array([0.0, 3.0]))
+    scan = ScanInput(np.full(360, np.inf), 0.0, math.pi / 180, 0.12, 3.5, 0.0)
+    states = []
+    for k in range(20):   # the robot does not move (pose fixed): no progress
+        ctl.update_scan(scan, 0.2 * k)
+        ctl.update_odom(0.2 * k, np.array([0.0, 0.0, math.pi / 2]), 0.2 * k)
+        states.append(ctl.tick(0.2 * k).state)
+    assert states[-1] == 'stuck: no progress, goal abandoned'
+    assert ctl.tick(4.0).command == (0.0, 0.0)
