@@ -20,17 +20,17 @@ import numpy as np
 from tqdm import tqdm
 
 from .config import METHODS, ConfigError, PlannerConfig, load_config
-from .episode import run_episode
+from .episode import Faults, run_episode
 from .paths import default_params_file, shipped_worlds_dir
 from .plots import plot_trajectories
 from .simulator import SimConfig
 from .world import WorldError, load_world, world_files
 
 
-def _run(job: tuple[str, str, PlannerConfig, SimConfig]) -> tuple[dict, list]:
-    path, method, cfg, sim_cfg = job
+def _run(job: tuple[str, str, PlannerConfig, SimConfig, Faults]) -> tuple[dict, list]:
+    path, method, cfg, sim_cfg, faults = job
     world = load_world(path)
-    result = run_episode(world, cfg.replace(method=method), sim_cfg)
+    result = run_episode(world, cfg.replace(method=method), sim_cfg, faults=faults)
     return result.metrics(world), result.path[:, :2].round(4).tolist()
 
 
@@ -78,6 +78,10 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
     p.add_argument('--noise', type=float, default=0.01,
                    help='laser range noise sigma [m] (Gazebo TurtleBot3: 0.01)')
     p.add_argument('--dropout', type=float, default=0.0, help='fraction of dropped beams')
+    p.add_argument('--scan-dropout', type=float, default=0.0,
+                   help='probability that a scan never reaches the planner')
+    p.add_argument('--scan-delay', type=int, default=0,
+                   help='planning periods between a scan and its delivery')
     p.add_argument('--no-plots', action='store_true', help='skip the PNGs')
     return p.parse_args(argv)
 
@@ -93,6 +97,7 @@ def main(argv: list[str] | None = None) -> int:
     try:
         cfg = load_config(args.params or default_params_file())
         sim_cfg = SimConfig(seed=args.seed, range_noise=args.noise, beam_dropout=args.dropout)
+        faults = Faults(args.scan_dropout, args.scan_delay)
         files = world_files(args.worlds or [shipped_worlds_dir()])
         worlds = {str(f): load_world(f) for f in files}
     except (ConfigError, WorldError, ValueError) as exc:
@@ -103,7 +108,7 @@ def main(argv: list[str] | None = None) -> int:
         return 2
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
-    jobs = [(f, m, cfg, sim_cfg) for f in worlds for m in methods]
+    jobs = [(f, m, cfg, sim_cfg, faults) for f in worlds for m in methods]
     t0 = time.perf_counter()
     with ProcessPoolExecutor(max_workers=max(1, args.jobs)) as pool:
         results = list(tqdm(pool.map(_run, jobs), total=len(jobs), unit='run',
@@ -111,7 +116,8 @@ def main(argv: list[str] | None = None) -> int:
     wall = time.perf_counter() - t0
     runs = [r for r, _ in results]
     doc = {'runs': runs, 'methods': methods, 'seed': args.seed, 'noise': args.noise,
-           'dropout': args.dropout, 'wall_time_s': round(wall, 2),
+           'dropout': args.dropout, 'scan_dropout': args.scan_dropout,
+           'scan_delay': args.scan_delay, 'wall_time_s': round(wall, 2),
            'params': {k: v for k, v in cfg.__dict__.items() if k != 'method'}}
     (out / 'results.json').write_text(json.dumps(doc, indent=1))
     (out / 'summary.md').write_text(summarise(runs, methods)

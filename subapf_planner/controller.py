@@ -98,6 +98,16 @@ class PlannerController:
         self.state = 'driving: new goal'
         return True
 
+    def clock_jumped_back(self) -> None:
+        """The clock went backwards (a restarted simulation): forget every input and its
+        time, keep the goal, and wait for fresh data."""
+        self.scan = self.scan_time = self.pose = self.odom_time = None
+        self.poses.clear()
+        self.planner.reset()
+        self._progress = None
+        if self.goal is not None:
+            self.state = 'driving: clock jumped back'
+
     def update_scan(self, scan: ScanInput, now: float) -> None:
         self.scan, self.scan_time = scan, now
 

@@ -8,6 +8,7 @@ simulated second. The same loop underlies ``subapf-bench``.
 
 from __future__ import annotations
 
+from collections import deque
 from dataclasses import dataclass, field
 import math
 import time
@@ -92,10 +93,30 @@ def mean_abs_curvature(path: np.ndarray, min_segment: float = 0.01) -> float:
     return float(np.mean(turn / (0.5 * (lengths[1:] + lengths[:-1]))))
 
 
+@dataclass(frozen=True)
+class Faults:
+    """Sensor faults between simulator and planner: a scan is lost with probability
+    ``scan_dropout`` (the planner keeps the last one it got) and reaches the planner
+    ``scan_delay`` planning periods after capture (placed with the pose at capture)."""
+
+    scan_dropout: float = 0.0
+    scan_delay: int = 0
+
+    def __post_init__(self) -> None:
+        if not 0.0 <= self.scan_dropout < 1.0:
+            raise ValueError(f'scan_dropout: {self.scan_dropout} is outside [0, 1)')
+        if not 0 <= self.scan_delay <= 50:
+            raise ValueError(f'scan_delay: {self.scan_delay} is outside [0, 50] periods')
+
+
 def run_episode(world: World, cfg: PlannerConfig, sim_cfg: SimConfig | None = None,
-                time_limit: float | None = None) -> EpisodeResult:
+                time_limit: float | None = None, faults: Faults | None = None) -> EpisodeResult:
     """Drive the world's start to its goal with ``cfg.method``; stop at the first outcome."""
     limit = world.time_limit if time_limit is None else time_limit
+    faults = faults or Faults()
+    rng = np.random.default_rng((sim_cfg.seed if sim_cfg else 0) + 7919)
+    in_flight: deque = deque()   # (scan, odom pose at capture) not yet delivered
+    delivered = None
     goal = np.asarray(world.goal, float)
     cfg = cfg.replace(goal_tolerance=min(cfg.goal_tolerance, world.goal_tolerance))
     planner = Planner(cfg)
@@ -113,11 +134,19 @@ def run_episode(world: World, cfg: PlannerConfig, sim_cfg: SimConfig | None = No
                 break
             if sim.time >= limit - 1e-9:
                 break
-            scan = sim.scan()
             odom, _ = sim.odometry()
+            if rng.random() >= faults.scan_dropout:
+                in_flight.append((sim.scan(), odom))
+            while in_flight and len(in_flight) > faults.scan_delay:
+                delivered = in_flight.popleft()
+            if delivered is None:   # nothing has arrived yet: wait, as the node does
+                sim.step(cfg.period)
+                continue
+            scan, scan_pose = delivered
             t0 = time.perf_counter()
             result = planner.step_scan(odom, goal, scan.ranges, scan.angle_min,
-                                       scan.angle_increment, scan.range_min, scan.range_max)
+                                       scan.angle_increment, scan.range_min, scan.range_max,
+                                       scan_pose)
             plan_ms.append((time.perf_counter() - t0) * 1e3)
             status = result.command.status
             statuses[status] = statuses.get(status, 0) + 1

@@ -25,6 +25,8 @@ from rcl_interfaces.msg import (
     SetParametersResult,
 )
 import rclpy
+from rclpy.clock import JumpThreshold
+from rclpy.duration import Duration
 from rclpy.exceptions import ParameterException
 from rclpy.executors import ExternalShutdownException
 from rclpy.node import Node
@@ -107,6 +109,10 @@ class PlannerNode(Node):
             self._set_goal(np.array([self.get_parameter('goal_x').value,
                                      self.get_parameter('goal_y').value]))
         self.timer = self.create_timer(self.cfg.period, self._on_timer)
+        self._jump_handle = self.get_clock().create_jump_callback(
+            JumpThreshold(min_forward=None, min_backward=Duration(nanoseconds=-1),
+                          on_clock_change=False),
+            post_callback=self._on_clock_jump)
         self.get_logger().info(
             f'method={self.cfg.method} d0={self.cfg.danger_distance} m '
             f'samples={self.cfg.num_samples} R={self.cfg.sample_radius} m '
@@ -141,6 +147,12 @@ class PlannerNode(Node):
         return Supervision(**{f: changes.get(f, self.get_parameter(f).value)
                               for f in ('scan_timeout', 'odom_timeout', 'progress_distance',
                                         'progress_timeout')})
+
+    def _on_clock_jump(self, jump) -> None:
+        if jump.delta.nanoseconds < 0:
+            self.get_logger().warn('clock jumped back (simulation restarted?): inputs reset')
+            self.ctl.clock_jumped_back()
+            self.timer.reset()
 
     # --- inputs -----------------------------------------------------------------------
     def _now(self) -> float:

@@ -13,6 +13,7 @@ PyPI ROS wheels; odom carries the same transform.)
 
 from __future__ import annotations
 
+from collections import deque
 import sys
 
 from geometry_msgs.msg import Twist, TwistStamped
@@ -26,7 +27,7 @@ from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import LaserScan
 from std_msgs.msg import String
 
-from .conversions import cmd_from_msg, odom_to_msg, scan_to_msg, seconds_to_stamp
+from .conversions import cmd_from_msg, odom_to_msg, scan_to_msg, seconds_to_stamp, stamp_to_seconds
 from .planner_node import descriptor
 from .simulator import BurgerSim, SimConfig
 from .world import WorldError, load_world
@@ -45,6 +46,7 @@ PARAMS: dict[str, tuple] = {
     'range_noise': (0.01, 'Laser range noise sigma [m]', 0.0, 1.0),
     'beam_dropout': (0.0, 'Fraction of beams dropped (+inf)', 0.0, 1.0),
     'scan_dropout': (0.0, 'Fraction of whole scans not published', 0.0, 1.0),
+    'scan_latency': (0.0, 'Scans are published this long after capture [s]', 0.0, 5.0),
     'odom_noise': (0.0, 'Relative odometry drift per step', 0.0, 1.0),
     'cmd_timeout': (0.5, 'Base watchdog: zero velocity after this without cmd_vel [s]',
                     0.05, 10.0),
@@ -68,6 +70,8 @@ class SimNode(Node):
             odom_noise=p['odom_noise'], cmd_timeout=p['cmd_timeout'], seed=p['seed']))
         self._rng = np.random.default_rng(p['seed'] + 1)
         self.scan_dropout = p['scan_dropout']
+        self.scan_latency = p['scan_latency']
+        self._scans: deque = deque()
         self.clock_pub = self.create_publisher(Clock, '/clock', 10)
         self.scan_pub = self.create_publisher(LaserScan, 'scan', qos_profile_sensor_data)
         self.odom_pub = self.create_publisher(Odometry, 'odom', 10)
@@ -102,8 +106,12 @@ class SimNode(Node):
             self._next_scan += SCAN_PERIOD
             if self._rng.random() >= self.scan_dropout:
                 s = sim.scan()
-                self.scan_pub.publish(scan_to_msg(s.ranges, s.angle_min, s.angle_increment,
-                                                  s.range_min, s.range_max, t, 'base_scan'))
+                self._scans.append(scan_to_msg(s.ranges, s.angle_min, s.angle_increment,
+                                               s.range_min, s.range_max, t, 'base_scan'))
+        # scans go out scan_latency after capture, stamped with their capture time
+        while self._scans and stamp_to_seconds(self._scans[0].header.stamp) \
+                + self.scan_latency <= t + 1e-9:
+            self.scan_pub.publish(self._scans.popleft())
         # the clock last: a node on sim time then has this tick's data when its timers fire
         self.clock_pub.publish(Clock(clock=seconds_to_stamp(t)))
         if self.outcome is None:

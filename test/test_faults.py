@@ -1,0 +1,92 @@
+"""Faults: lost and late scans in the loop, and input streams that stop and resume."""
+
+import math
+import os
+import time
+
+from conftest import WORLDS
+import numpy as np
+import pytest
+import rclpy
+from rclpy.executors import SingleThreadedExecutor
+from rclpy.parameter import Parameter
+
+from subapf_planner.config import PlannerConfig
+from subapf_planner.conversions import odom_to_msg, scan_to_msg
+from subapf_planner.episode import Faults, run_episode
+from subapf_planner.planner_node import PlannerNode
+from subapf_planner.simulator import SimConfig
+from subapf_planner.world import load_world, world_files
+
+FIG6 = ('fig6a_narrow_obstacles', 'fig6b_tight_space', 'fig6c_circle_in_front',
+        'fig6d_big_wall')
+
+
+@pytest.mark.parametrize('path', world_files([WORLDS]), ids=lambda p: p.stem)
+def test_lost_and_late_scans_never_cause_a_collision(path):
+    world = load_world(path)
+    result = run_episode(world, PlannerConfig(),
+                         SimConfig(range_noise=0.01, beam_dropout=0.05, seed=5),
+                         faults=Faults(scan_dropout=0.3, scan_delay=2))
+    assert result.outcome != 'collision'
+    if world.name in FIG6:
+        assert result.outcome == 'reached'
+
+
+def test_bad_fault_values():
+    with pytest.raises(ValueError, match='scan_dropout'):
+        Faults(scan_dropout=1.0)
+
+
+@pytest.fixture
+def node_and_clock():
+    os.environ['ROS_DOMAIN_ID'] = str(100 - os.getpid() % 30)
+    context = rclpy.Context()
+    rclpy.init(context=context)
+    node = PlannerNode(context=context, parameter_overrides=[
+        Parameter('scan_timeout', value=0.5), Parameter('odom_timeout', value=0.5)])
+    ex = SingleThreadedExecutor(context=context)
+    ex.add_node(node)
+    yield node, ex
+    ex.shutdown()
+    node.destroy_node()
+    rclpy.try_shutdown(context=context)
+
+
+@pytest.mark.parametrize('stream', ['scan', 'odom'])
+def test_stream_stops_then_resumes(node_and_clock, stream):
+    """Zero velocity within one planning period after the timeout; then drives again."""
+    node, ex = node_and_clock
+    sent = []
+    node._publish_cmd = lambda v, w, stamp=None: sent.append((time.monotonic(), v, w))
+    node._set_goal(np.array([3.0, 0.0]))
+    scan = scan_to_msg(np.full(360, np.inf), 0.0, math.pi / 180, 0.12, 3.5, 0.0, 'base_scan')
+    last_input = {'t': 0.0}
+
+    def feed(scan_on=True, odom_on=True):
+        now = node.get_clock().now()
+        if scan_on:
+            scan.header.stamp = now.to_msg()
+            node._on_scan(scan)
+        if odom_on:
+            node._on_odom(odom_to_msg(np.zeros(3), (0.0, 0.0), now.nanoseconds * 1e-9))
+        if (stream == 'scan' and scan_on) or (stream == 'odom' and odom_on):
+            last_input['t'] = time.monotonic()
+
+    def run(seconds, **on):
+        end = time.monotonic() + seconds
+        while time.monotonic() < end:
+            feed(**on)
+            ex.spin_once(timeout_sec=0.02)
+
+    run(1.0)
+    assert sent and sent[-1][1] > 0.0                       # driving
+    off = {'scan_on': stream != 'scan', 'odom_on': stream != 'odom'}
+    run(1.5, **off)
+    stops = [t for t, v, w in sent if t > last_input['t'] and v == 0.0 and w == 0.0]
+    assert stops, 'no zero command after the stream stopped'
+    assert stops[0] - last_input['t'] <= 0.5 + node.cfg.period + 0.1
+    assert node.ctl.state == f'stopped: {"scan" if stream == "scan" else "odometry"} is stale'
+    assert all(v == 0.0 for t, v, _ in sent if t > stops[0])
+    run(1.0)
+    assert sent[-1][1] > 0.0 and node.ctl.state.startswith('driving')   # no restart needed

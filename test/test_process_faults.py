@@ -1,0 +1,111 @@
+"""Process faults over real DDS: simulator restarted mid-run, planner killed mid-run."""
+
+import os
+import signal
+import time
+
+from conftest import PARAMS, WORLDS
+from nav_msgs.msg import Odometry
+import pytest
+import rclpy
+from rclpy.executors import SingleThreadedExecutor
+from std_msgs.msg import String
+
+from subapf_planner.processes import ros_env, start, stop
+from subapf_planner.sim_node import LATCHED
+
+WORLD = WORLDS / 'fig6d_big_wall.yaml'
+
+
+class Graph:
+    """sim_node and planner_node as child processes, and a monitor node here."""
+
+    def __init__(self, domain):
+        self.env = ros_env(domain)
+        os.environ.update(ROS_DOMAIN_ID=str(domain), ROS_AUTOMATIC_DISCOVERY_RANGE='LOCALHOST')
+        self.context = rclpy.Context()
+        rclpy.init(context=self.context)
+        self.node = rclpy.create_node('monitor', context=self.context)
+        self.ex = SingleThreadedExecutor(context=self.context)
+        self.ex.add_node(self.node)
+        self.truth, self.outcomes, self.status = [], [], []
+        self.node.create_subscription(Odometry, 'ground_truth', self.truth.append, 100)
+        self.node.create_subscription(String, 'sim_outcome',
+                                      lambda m: self.outcomes.append(m.data), LATCHED)
+        self.node.create_subscription(String, '/subapf_planner/status',
+                                      lambda m: self.status.append(m.data), 10)
+        self.children = []
+        self.sim = self.planner = None
+
+    def start_sim(self):
+        self.sim = start('sim_node', ['-p', f'world:={WORLD}', '-p', 'rate:=4.0'], self.env,
+                         quiet=True)
+        self.children.append(self.sim)
+
+    def start_planner(self):
+        self.planner = start('planner_node', [
+            '--params-file', str(PARAMS), '-p', 'use_sim_time:=true',
+            '-p', 'goal_from_parameters:=true', '-p', 'goal_x:=0.0', '-p', 'goal_y:=4.0'],
+            self.env, quiet=True)
+        self.children.append(self.planner)
+
+    def spin_until(self, predicate, timeout):
+        end = time.monotonic() + timeout
+        while time.monotonic() < end:
+            self.ex.spin_once(timeout_sec=0.05)
+            if predicate():
+                return True
+        return False
+
+    def speed(self):
+        return self.truth[-1].twist.twist.linear.x if self.truth else 0.0
+
+    def close(self):
+        stop(self.children)
+        self.node.destroy_node()
+        rclpy.try_shutdown(context=self.context)
+
+
+@pytest.fixture
+def graph(request):
+    g = Graph(request.param)
+    yield g
+    g.close()
+
+
+@pytest.mark.parametrize('graph', [76], indirect=True)
+def test_simulator_restarted_mid_run_planner_resumes(graph):
+    graph.start_planner()
+    graph.start_sim()
+    assert graph.spin_until(lambda: graph.speed() > 0.1, 60), 'robot never drove'
+    graph.sim.send_signal(signal.SIGKILL)
+    graph.sim.wait(10)
+    graph.truth.clear()
+    graph.start_sim()                      # a new simulation: clock and world from zero
+    assert graph.spin_until(lambda: graph.outcomes, 120), 'no outcome after the restart'
+    assert graph.outcomes[-1] == 'reached'
+    assert graph.planner.poll() is None    # the same planner process throughout
+
+
+@pytest.mark.parametrize('graph', [77], indirect=True)
+def test_planner_killed_robot_stops_on_its_watchdog(graph):
+    graph.start_planner()
+    graph.start_sim()
+    assert graph.spin_until(lambda: graph.speed() > 0.1, 60), 'robot never drove'
+    graph.planner.send_signal(signal.SIGKILL)
+    graph.planner.wait(10)
+    killed_at = graph.truth[-1].header.stamp.sec + graph.truth[-1].header.stamp.nanosec * 1e-9
+
+    def stopped():
+        if not graph.truth:
+            return False
+        m = graph.truth[-1]
+        t = m.header.stamp.sec + m.header.stamp.nanosec * 1e-9
+        return t > killed_at + 1.5 and abs(m.twist.twist.linear.x) < 0.01
+
+    assert graph.spin_until(stopped, 30)
+    # it stopped by the watchdog (0.5 s of simulated time), not by reaching anything
+    moving = [m for m in graph.truth if abs(m.twist.twist.linear.x) > 0.02
+              and m.header.stamp.sec + m.header.stamp.nanosec * 1e-9 > killed_at + 0.5 + 0.3]
+    assert not moving
+    assert graph.outcomes == []
