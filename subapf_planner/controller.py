@@ -98,15 +98,15 @@ class PlannerController:
         self.state = 'driving: new goal'
         return True
 
-    def clock_jumped_back(self) -> None:
-        """The clock went backwards (a restarted simulation): forget every input and its
-        time, keep the goal, and wait for fresh data."""
+    def clock_jumped(self) -> None:
+        """The clock jumped (a restarted simulation, a bag played from elsewhere): forget
+        every input and its time, keep the goal, and wait for fresh data."""
         self.scan = self.scan_time = self.pose = self.odom_time = None
         self.poses.clear()
         self.planner.reset()
         self._progress = None
         if self.goal is not None:
-            self.state = 'driving: clock jumped back'
+            self.state = 'driving: clock jumped'
 
     def update_scan(self, scan: ScanInput, now: float) -> None:
         self.scan, self.scan_time = scan, now

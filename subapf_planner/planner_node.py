@@ -47,6 +47,8 @@ from .conversions import (
 from .scan import geometry_warning
 
 NODE_NAME = 'subapf_planner'
+#: A forward clock jump longer than this, or any backward one, resets the inputs [s].
+CLOCK_JUMP = 1.0
 
 #: Node-only parameters: name -> (default, description, lo, hi).
 NODE_PARAMS: dict[str, tuple] = {
@@ -110,8 +112,8 @@ class PlannerNode(Node):
                                      self.get_parameter('goal_y').value]))
         self.timer = self.create_timer(self.cfg.period, self._on_timer)
         self._jump_handle = self.get_clock().create_jump_callback(
-            JumpThreshold(min_forward=None, min_backward=Duration(nanoseconds=-1),
-                          on_clock_change=False),
+            JumpThreshold(min_forward=Duration(seconds=CLOCK_JUMP),
+                          min_backward=Duration(nanoseconds=-1), on_clock_change=False),
             post_callback=self._on_clock_jump)
         self.get_logger().info(
             f'method={self.cfg.method} d0={self.cfg.danger_distance} m '
@@ -149,10 +151,9 @@ class PlannerNode(Node):
                                         'progress_timeout')})
 
     def _on_clock_jump(self, jump) -> None:
-        if jump.delta.nanoseconds < 0:
-            self.get_logger().warn('clock jumped back (simulation restarted?): inputs reset')
-            self.ctl.clock_jumped_back()
-            self.timer.reset()
+        self.get_logger().warn(f'clock jumped by {jump.delta.nanoseconds * 1e-9:+.2f} s '
+                               '(simulation restarted?): inputs reset')
+        self.ctl.clock_jumped()   # (rcl re-arms the timer itself after a jump back)
 
     # --- inputs -----------------------------------------------------------------------
     def _now(self) -> float:

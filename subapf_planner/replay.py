@@ -184,6 +184,8 @@ def main(argv: list[str] | None = None) -> int:
     if finite.any():
         print(f'|dv| max {d[finite, 0].max():.6f} mean {d[finite, 0].mean():.6f} m/s; '
               f'|dw| max {d[finite, 1].max():.6f} mean {d[finite, 1].mean():.6f} rad/s')
+    within = int(np.sum((d[:, 0] <= args.tolerance) & (d[:, 1] <= args.tolerance)))
+    print(f'within tolerance: {within} of {len(d)}')
     print('first divergence: ' + ('none' if first is None else f't = {first:.3f} s'))
     if args.output:
         write_commands(args.output, comparison)

@@ -90,3 +90,16 @@ def test_stream_stops_then_resumes(node_and_clock, stream):
     assert all(v == 0.0 for t, v, _ in sent if t > stops[0])
     run(1.0)
     assert sent[-1][1] > 0.0 and node.ctl.state.startswith('driving')   # no restart needed
+
+
+def test_clock_jump_resets_inputs_but_keeps_the_goal():
+    from subapf_planner.controller import PlannerController, ScanInput
+    ctl = PlannerController(PlannerConfig())
+    ctl.set_goal(np.array([3.0, 0.0]))
+    ctl.update_scan(ScanInput(np.full(360, np.inf), 0.0, math.pi / 180, 0.12, 3.5, 50.0), 50.0)
+    ctl.update_odom(50.0, np.zeros(3), 50.0)
+    assert ctl.tick(50.0).command[0] > 0
+    ctl.clock_jumped()
+    d = ctl.tick(0.2)
+    assert d.command is None and d.state == 'waiting: no scan yet'
+    assert ctl.goal is not None
