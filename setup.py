@@ -17,6 +17,7 @@ EXECUTABLES = [
     ('perf_nodes:main', 'nodeperf', 'subapf-nodeperf'),
     ('record:main', 'record', 'subapf-record'),
     ('replay:main', 'replay', 'subapf-replay'),
+    ('soak:main', 'soak', 'subapf-soak'),
 ]
 
 setup(

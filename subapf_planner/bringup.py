@@ -10,6 +10,7 @@ and exits 0 only when the goal was reached.
 from __future__ import annotations
 
 import argparse
+from dataclasses import dataclass, field
 import os
 from pathlib import Path
 import random
@@ -23,7 +24,7 @@ from .config import METHODS, load_config
 from .episode import path_length
 from .paths import default_params_file
 from .processes import ros_env, start, stop
-from .world import WorldError, load_world
+from .world import World, WorldError, load_world
 
 
 def parse_args(argv: list[str] | None) -> argparse.Namespace:
@@ -44,6 +45,61 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
     return p.parse_args(argv)
 
 
+@dataclass(frozen=True)
+class RunResult:
+    """One bringup run: outcome, simulated time [s], ground-truth path (k, 3) and the
+    resident memory samples [MiB] of each node, taken once a second."""
+
+    outcome: str
+    sim_time: float
+    path: np.ndarray
+    method: str
+    rss_mib: dict[str, list[float]] = field(default_factory=dict)
+
+
+def run_once(world: World, world_path: str, params: str, domain: int, *,
+             method: str | None = None, rate: float = 1.0, seed: int = 0,
+             sim_params: dict[str, float] | None = None, record: str | None = None,
+             record_topics: list[str] | None = None, timeout: float | None = None,
+             log_dir: Path | None = None) -> RunResult:
+    """Start both nodes on ``domain``, send the goal, wait for the outcome, stop both.
+
+    The nodes' output goes to the terminal, or to ``log_dir``/{sim,planner}.log.
+    """
+    env = ros_env(domain)
+    os.environ.update({k: env[k] for k in ('ROS_AUTOMATIC_DISCOVERY_RANGE', 'ROS_DOMAIN_ID')})
+    planner_args = ['--params-file', params, '-p', 'use_sim_time:=true']
+    if method:
+        planner_args += ['-p', f'method:={method}']
+    sim_args = ['-p', f'world:={world_path}', '-p', f'rate:={rate}', '-p', f'seed:={seed}']
+    for name, value in (sim_params or {}).items():
+        sim_args += ['-p', f'{name}:={value}']
+    timeout = timeout or 2.0 * world.time_limit / rate + 30.0
+
+    from .supervisor import Supervisor  # rclpy only after the environment is set
+    children: list[subprocess.Popen] = []
+    sup = None
+    previous = signal.signal(signal.SIGTERM, lambda *_: (_ for _ in ()).throw(
+        KeyboardInterrupt()))
+    logs = {name: (log_dir / f'{name}.log' if log_dir else None) for name in ('sim', 'planner')}
+    try:
+        children = [start('sim_node', sim_args, env, log=logs['sim']),
+                    start('planner_node', planner_args, env, log=logs['planner'])]
+        sup = Supervisor(world, record, method or load_config(params).method, record_topics)
+        outcome = sup.run(children, timeout, names=('sim_node', 'planner_node'))
+    except KeyboardInterrupt:
+        outcome = 'interrupted'
+    finally:
+        stop(children)
+        signal.signal(signal.SIGTERM, previous)
+        if sup is not None:
+            sup.close()
+    if sup is None:
+        return RunResult(outcome, 0.0, np.zeros((0, 3)), method or '')
+    path = np.asarray(sup.path) if sup.path else np.zeros((0, 3))
+    return RunResult(outcome, sup.sim_time, path, sup.method, sup.rss_mib)
+
+
 def main(argv: list[str] | None = None) -> int:
     args = parse_args(argv)
     try:
@@ -54,50 +110,31 @@ def main(argv: list[str] | None = None) -> int:
     if not 0.1 <= args.rate <= 100.0:
         print('subapf-bringup: --rate must be in [0.1, 100]', file=sys.stderr)
         return 2
+    from .supervisor import RECORDED
+    unknown = sorted(set(args.record_topics or ()) - set(RECORDED))
+    if unknown:
+        print(f'subapf-bringup: cannot record {unknown}; choose from {list(RECORDED)}',
+              file=sys.stderr)
+        return 2
     domain = args.domain_id if args.domain_id is not None else random.randint(1, 100)
-    env = ros_env(domain)
-    os.environ.update({k: env[k] for k in ('ROS_AUTOMATIC_DISCOVERY_RANGE', 'ROS_DOMAIN_ID')})
     params = str(Path(args.params or default_params_file()).resolve())
-    world_path = str(Path(args.world).resolve())
-    planner_args = ['--params-file', params, '-p', 'use_sim_time:=true']
-    if args.method:
-        planner_args += ['-p', f'method:={args.method}']
-    sim_args = ['-p', f'world:={world_path}', '-p', f'rate:={args.rate}',
-                '-p', f'seed:={args.seed}', '-p', f'range_noise:={args.noise}']
-    timeout = args.timeout or 2.0 * world.time_limit / args.rate + 30.0
     print(f'subapf-bringup: world {world.name}, domain {domain}, rate {args.rate}x',
           flush=True)
-
-    from .supervisor import Supervisor  # rclpy only after the environment is set
-    children: list[subprocess.Popen] = []
-    sup = None
-    previous = signal.signal(signal.SIGTERM, lambda *_: (_ for _ in ()).throw(
-        KeyboardInterrupt()))
-    try:
-        children = [start('sim_node', sim_args, env), start('planner_node', planner_args, env)]
-        sup = Supervisor(world, args.record, args.method or load_config(params).method,
-                         args.record_topics)
-        outcome = sup.run(children, timeout)
-    except KeyboardInterrupt:
-        outcome = 'interrupted'
-    finally:
-        stop(children)
-        signal.signal(signal.SIGTERM, previous)
-        if sup is not None:
-            sup.close()
-    path = np.asarray(sup.path) if sup is not None and sup.path else np.zeros((0, 3))
-    sim_time = sup.sim_time if sup is not None else 0.0
-    print(f'subapf-bringup: outcome {outcome}, simulated time {sim_time:.1f} s, '
-          f'path length {path_length(path):.2f} m', flush=True)
-    if len(path):
+    result = run_once(world, str(Path(args.world).resolve()), params, domain,
+                      method=args.method, rate=args.rate, seed=args.seed,
+                      sim_params={'range_noise': args.noise}, record=args.record,
+                      record_topics=args.record_topics, timeout=args.timeout)
+    print(f'subapf-bringup: outcome {result.outcome}, simulated time {result.sim_time:.1f} s, '
+          f'path length {path_length(result.path):.2f} m', flush=True)
+    if len(result.path):
         from .plots import plot_trajectories
-        png = plot_trajectories(world, {sup.method or 'planner': path},
-                                {sup.method or 'planner': outcome},
+        png = plot_trajectories(world, {result.method: result.path},
+                                {result.method: result.outcome},
                                 args.png or f'{world.name}.png')
         print(f'subapf-bringup: trajectory plot {png}')
     if args.record:
         print(f'subapf-bringup: recorded {args.record}')
-    return 0 if outcome == 'reached' else 1
+    return 0 if result.outcome == 'reached' else 1
 
 
 if __name__ == '__main__':

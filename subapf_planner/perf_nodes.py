@@ -23,20 +23,13 @@ import time
 import numpy as np
 
 from .paths import default_params_file, shipped_worlds_dir
-from .processes import ros_env, start, stop
+from .processes import ros_env, rss_mib, start, stop
 
 
 def proc_cpu_seconds(pid: int) -> float:
     """utime + stime of a process [s] (Linux /proc)."""
     fields = Path(f'/proc/{pid}/stat').read_text().rsplit(')', 1)[1].split()
     return (int(fields[11]) + int(fields[12])) / os.sysconf('SC_CLK_TCK')
-
-
-def proc_rss_mib(pid: int) -> float:
-    for line in Path(f'/proc/{pid}/status').read_text().splitlines():
-        if line.startswith('VmRSS:'):
-            return int(line.split()[1]) / 1024.0
-    return float('nan')
 
 
 def planner_figures(seconds: float, domain: int) -> dict[str, float]:
@@ -76,7 +69,7 @@ def planner_figures(seconds: float, domain: int) -> dict[str, float]:
         goal.header.frame_id = 'odom'
         goal.pose.position.x = goal.pose.position.y = 50.0
         goal_pub.publish(goal)
-        cpu0, rss0, t0 = proc_cpu_seconds(child.pid), proc_rss_mib(child.pid), time.monotonic()
+        cpu0, rss0, t0 = proc_cpu_seconds(child.pid), rss_mib(child.pid), time.monotonic()
         next_odom = next_scan = time.monotonic()
         while time.monotonic() - t0 < seconds:
             now = time.monotonic()
@@ -92,7 +85,7 @@ def planner_figures(seconds: float, domain: int) -> dict[str, float]:
             rclpy.spin_once(node, timeout_sec=0.005)
         cycles = len(latencies)
         cpu = proc_cpu_seconds(child.pid) - cpu0
-        rss1 = proc_rss_mib(child.pid)
+        rss1 = rss_mib(child.pid)
     finally:
         node.destroy_node()
         rclpy.try_shutdown()

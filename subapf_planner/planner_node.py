@@ -24,11 +24,9 @@ from rcl_interfaces.msg import (
     ParameterDescriptor,
     SetParametersResult,
 )
-import rclpy
 from rclpy.clock import JumpThreshold
 from rclpy.duration import Duration
 from rclpy.exceptions import ParameterException
-from rclpy.executors import ExternalShutdownException
 from rclpy.node import Node
 from rclpy.qos import qos_profile_sensor_data
 from sensor_msgs.msg import LaserScan
@@ -45,6 +43,7 @@ from .conversions import (
     stamp_to_seconds,
 )
 from .scan import geometry_warning
+from .spinning import spin_node
 
 NODE_NAME = 'subapf_planner'
 #: A forward clock jump longer than this, or any backward one, resets the inputs [s].
@@ -223,23 +222,8 @@ class PlannerNode(Node):
 
 
 def main(args: list[str] | None = None) -> int:
-    rclpy.init(args=args)
-    node = None
-    try:
-        node = PlannerNode()
-        rclpy.spin(node)
-    except (KeyboardInterrupt, ExternalShutdownException):
-        pass
-    except (ConfigError, ParameterException) as exc:
-        print(f'subapf-planner: bad parameter: {exc}', file=sys.stderr)
-        return 2
-    finally:
-        if node is not None:
-            if rclpy.ok():
-                node.stop_robot()
-            node.destroy_node()
-        rclpy.try_shutdown()
-    return 0
+    return spin_node(PlannerNode, 'subapf-planner: bad parameter',
+                     (ConfigError, ParameterException), PlannerNode.stop_robot, args)
 
 
 if __name__ == '__main__':

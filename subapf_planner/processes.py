@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import os
+from pathlib import Path
 import signal
 import subprocess
 import sys
@@ -20,15 +21,37 @@ def ros_env(domain_id: int) -> dict[str, str]:
     return env
 
 
-def start(module: str, ros_args: list[str], env: dict[str, str],
-          quiet: bool = False) -> subprocess.Popen:
+def start(module: str, ros_args: list[str], env: dict[str, str], quiet: bool = False,
+          log: Path | None = None) -> subprocess.Popen:
     """A node as a child process in its own process group (so it can be stopped whole).
 
-    ``quiet`` discards its output (its exit code still tells failure).
+    ``quiet`` discards its output (its exit code still tells failure); ``log`` sends
+    stdout and stderr to that file instead.
     """
-    pipes = dict(stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL) if quiet else {}
-    return subprocess.Popen([sys.executable, '-m', f'subapf_planner.{module}', '--ros-args',
-                             *ros_args], env=env, start_new_session=True, **pipes)
+    if log is not None:
+        out = open(log, 'w')   # the child keeps its own descriptor; ours closes below
+        pipes = dict(stdout=out, stderr=subprocess.STDOUT)
+    else:
+        out = None
+        pipes = dict(stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL) if quiet else {}
+    try:
+        return subprocess.Popen([sys.executable, '-m', f'subapf_planner.{module}',
+                                 '--ros-args', *ros_args], env=env, start_new_session=True,
+                                **pipes)
+    finally:
+        if out is not None:
+            out.close()
+
+
+def rss_mib(pid: int) -> float:
+    """Resident memory of a process [MiB] (Linux /proc); NaN once it is gone."""
+    try:
+        for line in Path(f'/proc/{pid}/status').read_text().splitlines():
+            if line.startswith('VmRSS:'):
+                return int(line.split()[1]) / 1024.0
+    except OSError:
+        pass
+    return float('nan')
 
 
 def stop(children: list[subprocess.Popen]) -> None:

@@ -19,8 +19,6 @@ import sys
 from geometry_msgs.msg import Twist, TwistStamped
 from nav_msgs.msg import Odometry
 import numpy as np
-import rclpy
-from rclpy.executors import ExternalShutdownException
 from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy, QoSProfile, qos_profile_sensor_data
 from rosgraph_msgs.msg import Clock
@@ -30,6 +28,7 @@ from std_msgs.msg import String
 from .conversions import cmd_from_msg, odom_to_msg, scan_to_msg, seconds_to_stamp, stamp_to_seconds
 from .planner_node import descriptor
 from .simulator import BurgerSim, SimConfig
+from .spinning import spin_node
 from .world import WorldError, load_world
 
 #: Simulated time per timer tick [s]; odometry and /clock go out every tick.
@@ -117,6 +116,10 @@ class SimNode(Node):
         if self.outcome is None:
             self._check_outcome()
 
+    def close(self) -> None:
+        """Release the physics server."""
+        self.sim.close()
+
     def _check_outcome(self) -> None:
         sim = self.sim
         x, y, _ = sim.true_pose()
@@ -133,22 +136,7 @@ class SimNode(Node):
 
 
 def main(args: list[str] | None = None) -> int:
-    rclpy.init(args=args)
-    node = None
-    try:
-        node = SimNode()
-        rclpy.spin(node)
-    except (KeyboardInterrupt, ExternalShutdownException):
-        pass
-    except (WorldError, ValueError) as exc:
-        print(f'subapf-sim: {exc}', file=sys.stderr)
-        return 2
-    finally:
-        if node is not None:
-            node.sim.close()
-            node.destroy_node()
-        rclpy.try_shutdown()
-    return 0
+    return spin_node(SimNode, 'subapf-sim', (WorldError, ValueError), SimNode.close, args)
 
 
 if __name__ == '__main__':

@@ -16,6 +16,7 @@ from std_msgs.msg import String
 from visualization_msgs.msg import MarkerArray
 
 from .conversions import pose_from_odom, stamp_to_seconds
+from .processes import rss_mib
 from .recorder import McapRecorder, type_name_of
 from .sim_node import LATCHED
 
@@ -51,6 +52,7 @@ class Supervisor:
         self.sim_time = 0.0
         self.outcome: str | None = None
         self.status = ''
+        self.rss_mib: dict[str, list[float]] = {}
         # latched, so a recorder that starts late still gets the goal
         self.goal_pub = self.node.create_publisher(PoseStamped, '/goal_pose', LATCHED)
         self.node.create_subscription(String, '/sim_outcome', self._on_outcome, LATCHED)
@@ -88,11 +90,18 @@ class Supervisor:
         goal.pose.orientation.w = 1.0
         self.goal_pub.publish(goal)
 
-    def run(self, children: list[subprocess.Popen], timeout: float) -> str:
-        """Spin until the simulator reports an outcome, a child dies, or the timeout."""
+    def run(self, children: list[subprocess.Popen], timeout: float,
+            names: tuple[str, ...] = ()) -> str:
+        """Spin until the simulator reports an outcome, a child dies, or the timeout.
+        Samples each named child's resident memory once a second into ``rss_mib``."""
         deadline = time.monotonic() + timeout
         goal_sent_at = None
+        next_sample = time.monotonic()
         while time.monotonic() < deadline:
+            if names and time.monotonic() >= next_sample:
+                next_sample += 1.0
+                for name, child in zip(names, children, strict=True):
+                    self.rss_mib.setdefault(name, []).append(rss_mib(child.pid))
             rclpy.spin_once(self.node, timeout_sec=0.05)
             if self.outcome is not None:
                 return self.outcome

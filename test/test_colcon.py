@@ -10,7 +10,7 @@ from conftest import REPO
 import pytest
 
 EXECUTABLES = ('planner_node', 'sim_node', 'bringup', 'bench', 'figures', 'perf', 'nodeperf',
-               'record',
+               'record', 'soak',
                'replay')
 
 

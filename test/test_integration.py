@@ -1,5 +1,6 @@
 """Real multi-process DDS runs: bringup over two worlds, recorded MCAP read by rosbags."""
 
+import json
 import os
 from pathlib import Path
 import signal
@@ -100,3 +101,17 @@ def test_standalone_recorder_finalises_on_sigint_and_replays(tmp_path):
     # test_replay.py.)
     within, total = map(int, r.stdout.split('within tolerance: ')[1].split()[0:3:2])
     assert total > 50 and within >= 0.9 * total, r.stdout
+
+
+def test_short_soak_reports_and_passes(tmp_path):
+    env = dict(os.environ, ROS_AUTOMATIC_DISCOVERY_RANGE='LOCALHOST')
+    r = subprocess.run([sys.executable, '-m', 'subapf_planner.soak', '--runs', '1', '--rate', '2',
+                        '--worlds',
+                        str(WORLDS / 'fig6c_circle_in_front.yaml'), '--out', str(tmp_path)],
+                       capture_output=True, text=True, timeout=240, env=env)
+    assert r.returncode == 0, r.stdout + r.stderr
+    doc = json.loads((tmp_path / 'soak.json').read_text())
+    assert doc['summary']['runs'] == 1 and doc['summary']['collisions'] == 0
+    assert doc['runs'][0]['outcome'] == 'reached'
+    assert set(doc['runs'][0]['rss_mib']) == {'sim_node', 'planner_node'}
+    assert (tmp_path / 'logs').is_dir()

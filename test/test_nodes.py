@@ -159,3 +159,12 @@ def test_twist_when_stamped_disabled(harness):
     h.goal(2.0, 0.0)
     assert h.spin_until(lambda: (h.feed(), len(h.cmds) > 0)[1])
     assert isinstance(h.cmds[0], Twist)
+
+
+def test_planning_frequency_change_retimes_the_timer(harness):
+    node = harness().node
+    assert node.timer.timer_period_ns == 200_000_000
+    assert node.set_parameters([Parameter('planning_frequency', value=10.0)])[0].successful
+    assert node.timer.timer_period_ns == 100_000_000
+    bad = node.set_parameters([Parameter('planning_frequency', value=1000.0)])[0]
+    assert not bad.successful and node.timer.timer_period_ns == 100_000_000
