@@ -14,7 +14,6 @@ from dataclasses import dataclass, field
 import os
 from pathlib import Path
 import random
-import signal
 import subprocess
 import sys
 
@@ -79,19 +78,16 @@ def run_once(world: World, world_path: str, params: str, domain: int, *,
     from .supervisor import Supervisor  # rclpy only after the environment is set
     children: list[subprocess.Popen] = []
     sup = None
-    previous = signal.signal(signal.SIGTERM, lambda *_: (_ for _ in ()).throw(
-        KeyboardInterrupt()))
     logs = {name: (log_dir / f'{name}.log' if log_dir else None) for name in ('sim', 'planner')}
     try:
         children = [start('sim_node', sim_args, env, log=logs['sim']),
                     start('planner_node', planner_args, env, log=logs['planner'])]
         sup = Supervisor(world, record, method or load_config(params).method, record_topics)
         outcome = sup.run(children, timeout, names=('sim_node', 'planner_node'))
-    except KeyboardInterrupt:
+    except KeyboardInterrupt:   # before the supervisor took over the signals
         outcome = 'interrupted'
     finally:
         stop(children)
-        signal.signal(signal.SIGTERM, previous)
         if sup is not None:
             sup.close()
     if sup is None:

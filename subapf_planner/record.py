@@ -9,7 +9,6 @@ and summary) on Ctrl-C, SIGTERM or after ``--duration`` seconds.
 from __future__ import annotations
 
 import argparse
-import signal
 import sys
 import time
 
@@ -17,9 +16,11 @@ import rclpy
 from rclpy.executors import ExternalShutdownException
 from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
+from rclpy.signals import SignalHandlerOptions
 
 from .bag import BagError, message_class
 from .recorder import McapRecorder, RecorderError
+from .spinning import stop_on_signals
 
 DEPTH = 500
 
@@ -64,14 +65,14 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument('-o', '--output', required=True, help='MCAP file to write')
     p.add_argument('--duration', type=float, default=None, help='stop after this many seconds')
     args = p.parse_args(rclpy.utilities.remove_ros_args(argv))
-    rclpy.init(args=['subapf-record', *argv])
-    signal.signal(signal.SIGTERM, lambda *_: rclpy.try_shutdown())
+    rclpy.init(args=['subapf-record', *argv], signal_handler_options=SignalHandlerOptions.NO)
+    stop = stop_on_signals()
     recorder = node = None
     try:
         recorder = McapRecorder(args.output)
         node = RecordNode(args.topics, recorder)
         end = None if args.duration is None else time.monotonic() + args.duration
-        while rclpy.ok() and (end is None or time.monotonic() < end):
+        while not stop.is_set() and (end is None or time.monotonic() < end):
             rclpy.spin_once(node, timeout_sec=0.1)
     except (KeyboardInterrupt, ExternalShutdownException):
         pass

@@ -10,6 +10,7 @@ from nav_msgs.msg import Odometry
 import rclpy
 from rclpy.node import Node
 from rclpy.qos import QoSProfile, ReliabilityPolicy
+from rclpy.signals import SignalHandlerOptions
 from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import LaserScan
 from std_msgs.msg import String
@@ -19,6 +20,7 @@ from .conversions import pose_from_odom, stamp_to_seconds
 from .processes import rss_mib
 from .recorder import McapRecorder, type_name_of
 from .sim_node import LATCHED
+from .spinning import stop_on_signals
 
 #: Depth of the recording subscriptions: deep enough that a busy recorder loses nothing.
 RECORD_DEPTH = 500
@@ -43,7 +45,8 @@ class Supervisor:
 
     def __init__(self, world, record: str | None, method: str | None = None,
                  record_topics: list[str] | None = None) -> None:
-        rclpy.init()
+        rclpy.init(signal_handler_options=SignalHandlerOptions.NO)
+        self.stop = stop_on_signals()   # Ctrl-C or SIGTERM end the run cleanly
         self.world = world
         self.method = method
         self.node = Node('subapf_bringup')
@@ -98,6 +101,8 @@ class Supervisor:
         goal_sent_at = None
         next_sample = time.monotonic()
         while time.monotonic() < deadline:
+            if self.stop.is_set():
+                return 'interrupted'
             if names and time.monotonic() >= next_sample:
                 next_sample += 1.0
                 for name, child in zip(names, children, strict=True):

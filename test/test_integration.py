@@ -115,3 +115,42 @@ def test_short_soak_reports_and_passes(tmp_path):
     assert doc['runs'][0]['outcome'] == 'reached'
     assert set(doc['runs'][0]['rss_mib']) == {'sim_node', 'planner_node'}
     assert (tmp_path / 'logs').is_dir()
+
+
+def processes_in_domain(domain: int) -> list[int]:
+    pids = []
+    for proc in Path('/proc').iterdir():
+        if not proc.name.isdigit() or int(proc.name) == os.getpid():
+            continue
+        try:
+            env = (proc / 'environ').read_bytes().split(b'\0')
+        except OSError:
+            continue
+        if f'ROS_DOMAIN_ID={domain}'.encode() in env:
+            pids.append(int(proc.name))
+    return pids
+
+
+@pytest.mark.parametrize('sig', [signal.SIGINT, signal.SIGTERM])
+def test_bringup_interrupted_stops_everything_and_finalises_the_bag(tmp_path, sig):
+    domain = 79 if sig == signal.SIGINT else 80
+    bag = tmp_path / 'cut.mcap'
+    env = dict(os.environ, ROS_AUTOMATIC_DISCOVERY_RANGE='LOCALHOST', ROS_DOMAIN_ID=str(domain))
+    p = subprocess.Popen([sys.executable, '-m', 'subapf_planner.bringup', '--world',
+                          str(WORLDS / 'fig6d_big_wall.yaml'), '--domain-id', str(domain),
+                          '--record', str(bag), '--png', str(tmp_path / 'p.png')],
+                         env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    lines = []
+    for line in p.stdout:
+        lines.append(line)
+        if 'planner driving' in line:
+            break
+    p.send_signal(sig)
+    out, _ = p.communicate(timeout=60)
+    text = ''.join(lines) + out
+    assert p.returncode == 1, text
+    assert 'outcome interrupted' in text and 'Traceback' not in text
+    assert processes_in_domain(domain) == []
+    from rosbags.highlevel import AnyReader
+    with AnyReader([bag]) as reader:
+        assert sum(1 for _ in reader.messages()) > 10

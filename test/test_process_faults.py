@@ -127,8 +127,8 @@ def test_planner_killed_robot_stops_on_its_watchdog(graph):
 def test_planner_stopped_cleanly_publishes_zero_velocity_last(graph, sig):
     graph.start_planner()
     graph.start_sim()
-    assert graph.spin_until(lambda: graph.speed() > 0.1, 60), 'robot never drove'
-    assert graph.cmds[-1].twist.linear.x > 0.0
+    assert graph.spin_until(lambda: graph.speed() > 0.1 and graph.cmds
+                            and graph.cmds[-1].twist.linear.x > 0.0, 60), 'robot never drove'
     graph.planner.send_signal(sig)
     assert graph.planner.wait(10) == 0, graph.logs()
     graph.spin_until(lambda: False, 0.5)   # let the last messages arrive
