@@ -5,7 +5,7 @@ from __future__ import annotations
 import math
 
 from builtin_interfaces.msg import Time
-from geometry_msgs.msg import Point, Twist, TwistStamped
+from geometry_msgs.msg import Point, TransformStamped, Twist, TwistStamped
 from nav_msgs.msg import Odometry
 import numpy as np
 from sensor_msgs.msg import LaserScan
@@ -79,6 +79,20 @@ def odom_to_msg(pose: np.ndarray, twist: tuple[float, float], stamp: float,
     msg.twist.twist.linear.x = float(twist[0])
     msg.twist.twist.angular.z = float(twist[1])
     return msg
+
+
+def transform_msg(parent: str, child: str, xyz: tuple[float, float, float], yaw: float,
+                  stamp: float) -> TransformStamped:
+    """A TransformStamped parent -> child (REP-105 frames), rotation about z only."""
+    t = TransformStamped()
+    t.header.stamp = seconds_to_stamp(stamp)
+    t.header.frame_id = parent
+    t.child_frame_id = child
+    t.transform.translation.x, t.transform.translation.y, t.transform.translation.z = \
+        map(float, xyz)
+    t.transform.rotation.z = math.sin(yaw / 2.0)
+    t.transform.rotation.w = math.cos(yaw / 2.0)
+    return t
 
 
 def cmd_to_msg(v: float, w: float, stamped: bool, stamp: Time | None = None,

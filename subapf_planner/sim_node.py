@@ -7,8 +7,8 @@ world frame) and the run's outcome on ``sim_outcome`` (std_msgs/String:
 reached, collision or timeout; transient-local, published once). Subscribes
 ``cmd_vel`` (TwistStamped, or Twist with enable_stamped_cmd_vel:=false).
 Physics advances in steps of 50 ms of simulated time on a wall-clock timer,
-``rate`` times faster than real time. (No /tf: tf2_msgs is not among the
-PyPI ROS wheels; odom carries the same transform.)
+``rate`` times faster than real time. ``/tf`` and ``/tf_static`` go out when
+tf2_msgs is installed (not among the PyPI ROS wheels; odom carries the same pose).
 """
 
 from __future__ import annotations
@@ -25,15 +25,25 @@ from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import LaserScan
 from std_msgs.msg import String
 
-from .conversions import cmd_from_msg, odom_to_msg, scan_to_msg, seconds_to_stamp, stamp_to_seconds
+from .conversions import (
+    cmd_from_msg,
+    odom_to_msg,
+    scan_to_msg,
+    seconds_to_stamp,
+    stamp_to_seconds,
+    transform_msg,
+)
 from .planner_node import descriptor
-from .simulator import BurgerSim, SimConfig
+from .simulator import LASER_OFFSET, BurgerSim, SimConfig
 from .spinning import spin_node
 from .world import WorldError, load_world
 
 #: Simulated time per timer tick [s]; odometry and /clock go out every tick.
 TICK = 0.05
 SCAN_PERIOD = 0.2
+#: REP-105 frames of the burger: base_link above base_footprint, base_scan in base_link.
+BASE_LINK_HEIGHT = 0.010
+LASER_IN_BASE_LINK = (LASER_OFFSET[0], LASER_OFFSET[1], LASER_OFFSET[2] - BASE_LINK_HEIGHT)
 #: Shortest wall-clock period of the stepping timer [s].
 MIN_TIMER_PERIOD = 0.005
 LATCHED = QoSProfile(depth=1, durability=DurabilityPolicy.TRANSIENT_LOCAL)
@@ -76,6 +86,7 @@ class SimNode(Node):
         self.odom_pub = self.create_publisher(Odometry, 'odom', 10)
         self.truth_pub = self.create_publisher(Odometry, 'ground_truth', 10)
         self.outcome_pub = self.create_publisher(String, 'sim_outcome', LATCHED)
+        self._setup_tf()
         cmd_type = TwistStamped if p['enable_stamped_cmd_vel'] else Twist
         self.create_subscription(cmd_type, 'cmd_vel', self._on_cmd, 10)
         self.outcome: str | None = None
@@ -85,6 +96,23 @@ class SimNode(Node):
         self.ticks_per_call = max(1, int(round(MIN_TIMER_PERIOD * p['rate'] / TICK)))
         self.timer = self.create_timer(self.ticks_per_call * TICK / p['rate'], self._on_timer)
         self.get_logger().info(f'world {self.world.name} from {p["world"]}, rate {p["rate"]}x')
+
+    def _setup_tf(self) -> None:
+        """/tf (odom -> base_footprint) and /tf_static (base_footprint -> base_link ->
+        base_scan) when tf2_msgs is installed (a Jazzy install has it; the PyPI wheels
+        this project tests with do not, and then odom alone carries the pose)."""
+        try:
+            from tf2_msgs.msg import TFMessage
+        except ImportError:
+            self.tf_pub = None
+            self.get_logger().info('tf2_msgs not installed: no /tf published')
+            return
+        self._tf_message = TFMessage
+        self.tf_pub = self.create_publisher(TFMessage, '/tf', 10)
+        static = self.create_publisher(TFMessage, '/tf_static', LATCHED)
+        static.publish(TFMessage(transforms=[
+            transform_msg('base_footprint', 'base_link', (0.0, 0.0, BASE_LINK_HEIGHT), 0.0, 0.0),
+            transform_msg('base_link', 'base_scan', LASER_IN_BASE_LINK, 0.0, 0.0)]))
 
     def _on_cmd(self, msg: Twist | TwistStamped) -> None:
         self.sim.set_command(*cmd_from_msg(msg))
@@ -100,6 +128,9 @@ class SimNode(Node):
         t = sim.time
         pose, twist = sim.odometry()
         self.odom_pub.publish(odom_to_msg(pose, twist, t))
+        if self.tf_pub is not None:
+            self.tf_pub.publish(self._tf_message(transforms=[transform_msg(
+                'odom', 'base_footprint', (pose[0], pose[1], 0.0), pose[2], t)]))
         self.truth_pub.publish(odom_to_msg(sim.true_pose(), twist, t, 'world'))
         if t + 1e-9 >= self._next_scan:
             self._next_scan += SCAN_PERIOD

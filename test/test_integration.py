@@ -71,10 +71,11 @@ def test_bad_world_and_bad_parameters_exit_with_clear_errors(tmp_path):
                         '--params-file', str(PARAMS), '-p', 'method:=teleport'],
                        capture_output=True, text=True, timeout=60, env=env)
     assert r.returncode == 2 and "method: 'teleport' is not one of" in r.stderr
-    r = subprocess.run([sys.executable, '-m', 'subapf_planner.planner_node', '--ros-args',
-                        '-p', 'danger_distance:=5.0'],
-                       capture_output=True, text=True, timeout=60, env=env)
-    assert r.returncode == 2 and 'danger_distance' in r.stderr
+    for bad in ('danger_distance:=5.0', 'danger_distance:=wide', 'num_samples:=2.5'):
+        r = subprocess.run([sys.executable, '-m', 'subapf_planner.planner_node', '--ros-args',
+                            '-p', bad], capture_output=True, text=True, timeout=60, env=env)
+        assert r.returncode == 2 and bad.split(':=')[0] in r.stderr, (bad, r.stderr)
+        assert 'Traceback' not in r.stderr
 
 
 def test_standalone_recorder_finalises_on_sigint_and_replays(tmp_path):

@@ -168,3 +168,10 @@ def test_planning_frequency_change_retimes_the_timer(harness):
     assert node.timer.timer_period_ns == 100_000_000
     bad = node.set_parameters([Parameter('planning_frequency', value=1000.0)])[0]
     assert not bad.successful and node.timer.timer_period_ns == 100_000_000
+
+
+def test_wrong_type_at_run_time_is_refused(harness):
+    node = harness().node
+    result = node.set_parameters([Parameter('danger_distance', value='wide')])[0]
+    assert not result.successful
+    assert node.get_parameter('danger_distance').value == 0.25

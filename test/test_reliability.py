@@ -237,3 +237,15 @@ def test_goal_behind_a_wall_without_progress_becomes_stuck():
         states.append(ctl.tick(0.2 * k).state)
     assert states[-1] == 'stuck: no progress, goal abandoned'
     assert ctl.tick(4.0).command == (0.0, 0.0)
+
+
+def test_tf_frames_follow_rep105():
+    from subapf_planner.conversions import transform_msg
+    from subapf_planner.sim_node import BASE_LINK_HEIGHT, LASER_IN_BASE_LINK
+    t = transform_msg('odom', 'base_footprint', (1.0, 2.0, 0.0), math.pi / 2, 3.5)
+    assert (t.header.frame_id, t.child_frame_id) == ('odom', 'base_footprint')
+    assert t.transform.rotation.z == pytest.approx(math.sqrt(0.5))
+    assert t.header.stamp.sec == 3 and t.header.stamp.nanosec == 500_000_000
+    # base_scan 0.172 m above base_link, base_link 0.010 m above base_footprint
+    assert LASER_IN_BASE_LINK == pytest.approx((-0.032, 0.0, 0.172))
+    assert BASE_LINK_HEIGHT == 0.010
