@@ -106,6 +106,9 @@ def main(argv: list[str] | None = None) -> int:
     if not 0.1 <= args.rate <= 100.0:
         print('subapf-bringup: --rate must be in [0.1, 100]', file=sys.stderr)
         return 2
+    if args.domain_id is not None and not 0 <= args.domain_id <= 101:
+        print('subapf-bringup: --domain-id must be in [0, 101]', file=sys.stderr)
+        return 2
     from .supervisor import RECORDED
     unknown = sorted(set(args.record_topics or ()) - set(RECORDED))
     if unknown:

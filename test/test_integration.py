@@ -66,6 +66,10 @@ def test_bad_world_and_bad_parameters_exit_with_clear_errors(tmp_path):
     r = subprocess.run([sys.executable, '-m', 'subapf_planner.bringup', '--world', str(bad)],
                        capture_output=True, text=True, timeout=60)
     assert r.returncode == 2 and 'start: expected a list of 3 numbers' in r.stderr
+    r = subprocess.run([sys.executable, '-m', 'subapf_planner.bringup', '--world',
+                        str(WORLDS / 'u_trap.yaml'), '--domain-id', '500'],
+                       capture_output=True, text=True, timeout=60)
+    assert r.returncode == 2 and '--domain-id must be in [0, 101]' in r.stderr
     env = dict(os.environ, ROS_AUTOMATIC_DISCOVERY_RANGE='LOCALHOST', ROS_DOMAIN_ID='73')
     r = subprocess.run([sys.executable, '-m', 'subapf_planner.planner_node', '--ros-args',
                         '--params-file', str(PARAMS), '-p', 'method:=teleport'],
