@@ -54,8 +54,33 @@ def node_and_clock():
 
 
 @pytest.mark.parametrize('stream', ['scan', 'odom'])
+def test_stale_input_stops_within_one_period_of_its_timeout(stream):
+    """The controller on a 5 Hz tick: zero velocity at the first tick past the timeout."""
+    from subapf_planner.controller import PlannerController, ScanInput, Supervision
+    ctl = PlannerController(PlannerConfig(), Supervision(scan_timeout=0.5, odom_timeout=0.5))
+    ctl.set_goal(np.array([3.0, 0.0]))
+    scan = ScanInput(np.full(360, np.inf), 0.0, math.pi / 180, 0.12, 3.5, 0.0)
+    last_input, first_stop = 1.0, None
+    for k in range(1, 20):
+        t = 0.2 * k
+        if t <= last_input or stream != 'scan':
+            ctl.update_scan(scan, t)
+        if t <= last_input or stream != 'odom':
+            ctl.update_odom(t, np.zeros(3), t)
+        d = ctl.tick(t)
+        if t <= last_input:
+            assert d.command[0] > 0.0
+        elif first_stop is None and d.command == (0.0, 0.0):
+            first_stop = t
+    assert first_stop is not None
+    assert 0.5 < first_stop - last_input <= 0.5 + 0.2 + 1e-9
+
+
+@pytest.mark.parametrize('stream', ['scan', 'odom'])
 def test_stream_stops_then_resumes(node_and_clock, stream):
-    """Zero velocity within one planning period after the timeout; then drives again."""
+    """The node over wall time: stops after the timeout (the bound is loose, this is a
+    loaded 2-core machine; the exact bound is tested on the controller above), then
+    drives again when the stream resumes, without a restart."""
     node, ex = node_and_clock
     sent = []
     node._publish_cmd = lambda v, w, stamp=None: sent.append((time.monotonic(), v, w))
@@ -85,7 +110,7 @@ def test_stream_stops_then_resumes(node_and_clock, stream):
     run(1.5, **off)
     stops = [t for t, v, w in sent if t > last_input['t'] and v == 0.0 and w == 0.0]
     assert stops, 'no zero command after the stream stopped'
-    assert stops[0] - last_input['t'] <= 0.5 + node.cfg.period + 0.1
+    assert stops[0] - last_input['t'] <= 0.5 + 3 * node.cfg.period
     assert node.ctl.state == f'stopped: {"scan" if stream == "scan" else "odometry"} is stale'
     assert all(v == 0.0 for t, v, _ in sent if t > stops[0])
     run(1.0)
