@@ -11,7 +11,6 @@ from __future__ import annotations
 
 import argparse
 from dataclasses import dataclass, field
-import os
 from pathlib import Path
 import random
 import subprocess
@@ -22,7 +21,7 @@ import numpy as np
 from .config import METHODS, load_config
 from .episode import path_length
 from .paths import default_params_file
-from .processes import ros_env, start, stop
+from .processes import join_domain, start, stop
 from .world import World, WorldError, load_world
 
 
@@ -65,8 +64,7 @@ def run_once(world: World, world_path: str, params: str, domain: int, *,
 
     The nodes' output goes to the terminal, or to ``log_dir``/{sim,planner}.log.
     """
-    env = ros_env(domain)
-    os.environ.update({k: env[k] for k in ('ROS_AUTOMATIC_DISCOVERY_RANGE', 'ROS_DOMAIN_ID')})
+    env = join_domain(domain)
     planner_args = ['--params-file', params, '-p', 'use_sim_time:=true']
     if method:
         planner_args += ['-p', f'method:={method}']

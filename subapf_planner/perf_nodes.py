@@ -22,8 +22,9 @@ import time
 
 import numpy as np
 
+from .conversions import stamp_to_seconds
 from .paths import default_params_file, shipped_worlds_dir
-from .processes import ros_env, rss_mib, start, stop
+from .processes import join_domain, rss_mib, start, stop
 
 
 def proc_cpu_seconds(pid: int) -> float:
@@ -47,8 +48,7 @@ def planner_figures(seconds: float, domain: int) -> dict[str, float]:
     with BurgerSim(world, SimConfig(range_noise=0.01)) as sim:
         scan = sim.scan()
         pose = sim.odometry()[0]
-    env = ros_env(domain)
-    os.environ.update({k: env[k] for k in ('ROS_AUTOMATIC_DISCOVERY_RANGE', 'ROS_DOMAIN_ID')})
+    env = join_domain(domain)
     child = start('planner_node', ['--params-file', str(default_params_file()),
                                    '-p', 'progress_timeout:=600.0'], env, quiet=True)
     rclpy.init()
@@ -56,7 +56,7 @@ def planner_figures(seconds: float, domain: int) -> dict[str, float]:
     latencies: list[float] = []
 
     def on_cmd(msg: TwistStamped) -> None:
-        sent = msg.header.stamp.sec + msg.header.stamp.nanosec * 1e-9
+        sent = stamp_to_seconds(msg.header.stamp)
         latencies.append(node.get_clock().now().nanoseconds * 1e-9 - sent)
     node.create_subscription(TwistStamped, 'cmd_vel', on_cmd, 10)
     scan_pub = node.create_publisher(LaserScan, 'scan', qos_profile_sensor_data)
@@ -106,8 +106,7 @@ def sim_node_rtf(domain: int) -> float:
 
     from .sim_node import LATCHED
     from .world import load_world
-    env = ros_env(domain)
-    os.environ.update({k: env[k] for k in ('ROS_AUTOMATIC_DISCOVERY_RANGE', 'ROS_DOMAIN_ID')})
+    env = join_domain(domain)
     world_file = shipped_worlds_dir() / 'fig6d_big_wall.yaml'
     limit = load_world(world_file).time_limit
     child = start('sim_node', ['-p', f'world:={world_file}', '-p', 'rate:=100.0'], env,
@@ -119,7 +118,7 @@ def sim_node_rtf(domain: int) -> float:
     node.create_subscription(String, 'sim_outcome', lambda m: done.append(time.monotonic()),
                              LATCHED)
     sub = node.create_subscription(Clock, '/clock', lambda m: first.append(
-        (time.monotonic(), m.clock.sec + m.clock.nanosec * 1e-9)), 1)
+        (time.monotonic(), stamp_to_seconds(m.clock))), 1)
     try:
         end = time.monotonic() + 120.0
         while not done and time.monotonic() < end:

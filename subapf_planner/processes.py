@@ -12,13 +12,12 @@ import time
 CHILD_STOP_TIMEOUT = 5.0
 
 
-def ros_env(domain_id: int) -> dict[str, str]:
-    """The environment for every process of one bringup: DDS on loopback, own domain."""
-    env = dict(os.environ)
-    env['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
-    env['ROS_DOMAIN_ID'] = str(domain_id)
-    env['PYTHONUNBUFFERED'] = '1'
-    return env
+def join_domain(domain_id: int) -> dict[str, str]:
+    """Put this process on DDS over loopback in its own domain (set before its rclpy
+    init), and return the environment for the child processes that share the domain."""
+    os.environ['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
+    os.environ['ROS_DOMAIN_ID'] = str(domain_id)
+    return dict(os.environ, PYTHONUNBUFFERED='1')
 
 
 def start(module: str, ros_args: list[str], env: dict[str, str], quiet: bool = False,

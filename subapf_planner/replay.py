@@ -106,13 +106,12 @@ def replay(path: str, cfg: PlannerConfig, limits: Supervision,
             if np.all(np.isfinite(payload)):
                 ctl.set_goal(payload)
         else:
-            if skipped == len(replayed) and (ctl.scan is None or ctl.pose is None
-                                             or ctl.goal is None):
+            leading = skipped == len(replayed) and (ctl.scan is None or ctl.pose is None
+                                                    or ctl.goal is None)
+            decision = ctl.tick(t)
+            if leading:
                 skipped += 1
-                decision = ctl.tick(t)
                 ctl.planner.previous = payload   # the node's state after what it published
-            else:
-                decision = ctl.tick(t)
             times.append(t)
             recorded.append(payload)
             replayed.append(decision.command if decision.command is not None

@@ -11,7 +11,6 @@ the recorded ones and with the in-process replay (replay.py).
 
 from __future__ import annotations
 
-import os
 from pathlib import Path
 import subprocess
 import time
@@ -28,7 +27,7 @@ from std_msgs.msg import String
 
 from .bag import BagError, read
 from .conversions import cmd_from_msg, seconds_to_stamp, stamp_to_seconds
-from .processes import ros_env, start, stop
+from .processes import join_domain, start, stop
 from .replay import Comparison, check_topics
 
 #: Longest wait for the node's answer to one tick [s].
@@ -73,8 +72,7 @@ def replay_through_node(path: str, params: str, names: dict[str, str],
     """Run the bag through a planner_node process; see the module docstring."""
     check_topics(path, names)
     instants = _instants(path, names)
-    env = ros_env(domain)
-    os.environ.update({k: env[k] for k in ('ROS_AUTOMATIC_DISCOVERY_RANGE', 'ROS_DOMAIN_ID')})
+    env = join_domain(domain)
     ros_args = ['--params-file', str(Path(params).resolve()), '-p', 'use_sim_time:=true']
     if method:
         ros_args += ['-p', f'method:={method}']

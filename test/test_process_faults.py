@@ -1,6 +1,5 @@
 """Process faults over real DDS: simulator restarted mid-run, planner killed mid-run."""
 
-import os
 import signal
 import time
 
@@ -12,7 +11,8 @@ import rclpy
 from rclpy.executors import SingleThreadedExecutor
 from std_msgs.msg import String
 
-from subapf_planner.processes import ros_env, start, stop
+from subapf_planner.conversions import stamp_to_seconds
+from subapf_planner.processes import join_domain, start, stop
 from subapf_planner.sim_node import LATCHED
 
 WORLD = WORLDS / 'fig6d_big_wall.yaml'
@@ -23,8 +23,7 @@ class Graph:
 
     def __init__(self, domain, log_dir):
         self.log_dir = log_dir
-        self.env = ros_env(domain)
-        os.environ.update(ROS_DOMAIN_ID=str(domain), ROS_AUTOMATIC_DISCOVERY_RANGE='LOCALHOST')
+        self.env = join_domain(domain)
         self.context = rclpy.Context()
         rclpy.init(context=self.context)
         self.node = rclpy.create_node('monitor', context=self.context)
@@ -105,20 +104,20 @@ def test_simulator_restarted_mid_run_planner_resumes(graph):
 @pytest.mark.parametrize('graph', [77], indirect=True)
 def test_planner_killed_robot_stops_on_its_watchdog(graph):
     drive_then_kill(graph, 'planner')
-    killed_at = graph.truth[-1].header.stamp.sec + graph.truth[-1].header.stamp.nanosec * 1e-9
+    killed_at = stamp_to_seconds(graph.truth[-1].header.stamp)
 
     def stopped():
         if not graph.truth:
             return False
         m = graph.truth[-1]
-        t = m.header.stamp.sec + m.header.stamp.nanosec * 1e-9
+        t = stamp_to_seconds(m.header.stamp)
         return t > killed_at + 2.5 and abs(m.twist.twist.linear.x) < 0.01
 
     assert graph.spin_until(stopped, 30)
     # it stopped by the watchdog (0.5 s of simulated time; exact in test_simulator.py),
     # not by reaching anything; the bound allows for this monitor lagging behind
     moving = [m for m in graph.truth if abs(m.twist.twist.linear.x) > 0.02
-              and m.header.stamp.sec + m.header.stamp.nanosec * 1e-9 > killed_at + 2.0]
+              and stamp_to_seconds(m.header.stamp) > killed_at + 2.0]
     assert not moving
     assert graph.outcomes == []
 
