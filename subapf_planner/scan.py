@@ -66,12 +66,15 @@ def geometry_warning(n: int, angle_min: float, angle_max: float,
                      angle_increment: float) -> str | None:
     """Why a scan's header is suspicious, or None. Such a scan is still used, with beam
     i at angle_min + i * angle_increment (LDS-02 beam counts vary from scan to scan)."""
-    if n > 1 and angle_increment > 0.0 and n * angle_increment > 2.0 * math.pi + angle_increment:
+    if n < 2 or not math.isfinite(angle_increment) or angle_increment <= 0.0:
+        return None   # no usable geometry: scan_to_points refuses the scan itself
+    if n * angle_increment > 2.0 * math.pi + angle_increment:
         return f'{n} beams of {angle_increment:.5f} rad cover more than a full turn'
-    if n > 1 and angle_increment > 0.0 and math.isfinite(angle_max):
-        expected = int(round((angle_max - angle_min) / angle_increment)) + 1
-        if abs(expected - n) > 1:
-            return f'{n} ranges, but angle_min/angle_max/angle_increment describe {expected}'
+    if not (math.isfinite(angle_min) and math.isfinite(angle_max)):
+        return None
+    expected = int(round((angle_max - angle_min) / angle_increment)) + 1
+    if abs(expected - n) > 1:
+        return f'{n} ranges, but angle_min/angle_max/angle_increment describe {expected}'
     return None
 
 

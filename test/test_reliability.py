@@ -111,19 +111,21 @@ def goal_msg(x, y, frame='odom'):
 
 
 @given(ranges=st.lists(weird, max_size=400), angle_min=weird, inc=weird, rmin=weird,
-       rmax=weird, frame=st.sampled_from(['base_scan', 'laser', '']),
+       rmax=weird, angle_max=st.one_of(st.none(), weird),
+       frame=st.sampled_from(['base_scan', 'laser', '']),
        x=st.one_of(coord, st.just(math.nan)), y=coord,
        q=st.tuples(weird, weird, weird, weird), cov=weird,
        goal=st.one_of(st.none(), st.tuples(weird, weird, st.sampled_from(['odom', 'map']))))
 @settings(max_examples=1000, deadline=None,
           suppress_health_check=[HealthCheck.function_scoped_fixture])
-def test_fuzz_node(node, ranges, angle_min, inc, rmin, rmax, frame, x, y, q, cov, goal):
+def test_fuzz_node(node, ranges, angle_min, inc, rmin, rmax, angle_max, frame, x, y, q, cov,
+                   goal):
     cap = Captured(node)
     if goal is not None:
         node._on_goal(goal_msg(*goal))
     elif node.ctl.goal is None:
         node._on_goal(goal_msg(2.5, 1.0))
-    node._on_scan(scan_msg(ranges, angle_min, inc, rmin, rmax, frame))
+    node._on_scan(scan_msg(ranges, angle_min, inc, rmin, rmax, frame, angle_max))
     node._on_odom(odom_msg(x, y, q, cov))
     node._on_timer()
     for (v, w), d in zip(cap.cmds, [d for d in cap.decisions if d.command], strict=True):
@@ -157,6 +159,13 @@ def test_wrong_frame_scan_is_dropped(node):
 @pytest.mark.parametrize('inc', [0.0, -0.01, math.nan])
 def test_bad_angle_increment_stops(node, inc):
     d = drive(node, scan_msg([1.0] * 10, 0.0, inc, 0.12, 3.5, 'base_scan'))
+    assert d.command == (0.0, 0.0) and d.state == 'stopped: invalid_scan'
+
+
+def test_nan_angle_min_with_finite_angle_max_stops(node):
+    msg = scan_msg([1.0] * 10, math.nan, 0.01, 0.12, 3.5, 'base_scan', angle_max=1.0)
+    assert geometry_warning(10, math.nan, 1.0, 0.01) is None
+    d = drive(node, msg)
     assert d.command == (0.0, 0.0) and d.state == 'stopped: invalid_scan'
 
 
