@@ -8,23 +8,23 @@ PACKAGE = 'subapf_planner'
 
 # (module:function, ros2 run name, plain command name)
 EXECUTABLES = [
-    ('planner_node:main', 'planner_node', 'subapf-planner'),
-    ('sim_node:main', 'sim_node', 'subapf-sim'),
-    ('bringup:main', 'bringup', 'subapf-bringup'),
-    ('bench:main', 'bench', 'subapf-bench'),
-    ('figures:main', 'figures', 'subapf-figures'),
-    ('perf:main', 'perf', 'subapf-perf'),
-    ('perf_nodes:main', 'nodeperf', 'subapf-nodeperf'),
-    ('record:main', 'record', 'subapf-record'),
-    ('replay:main', 'replay', 'subapf-replay'),
-    ('soak:main', 'soak', 'subapf-soak'),
+    ('ros.planner_node:main', 'planner_node', 'subapf-planner'),
+    ('ros.sim_node:main', 'sim_node', 'subapf-sim'),
+    ('tools.bringup:main', 'bringup', 'subapf-bringup'),
+    ('tools.bench:main', 'bench', 'subapf-bench'),
+    ('tools.figures:main', 'figures', 'subapf-figures'),
+    ('tools.perf:main', 'perf', 'subapf-perf'),
+    ('tools.nodeperf:main', 'nodeperf', 'subapf-nodeperf'),
+    ('tools.record:main', 'record', 'subapf-record'),
+    ('tools.replay:main', 'replay', 'subapf-replay'),
+    ('tools.soak:main', 'soak', 'subapf-soak'),
 ]
 
 setup(
     name=PACKAGE,
     version='0.1.0',
     packages=find_packages(exclude=['test']),
-    package_data={PACKAGE: ['urdf/*.urdf']},
+    package_data={PACKAGE + '.sim': ['urdf/*.urdf']},
     data_files=[
         ('share/ament_index/resource_index/packages', ['resource/' + PACKAGE]),
         ('share/' + PACKAGE, ['package.xml']),

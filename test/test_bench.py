@@ -4,10 +4,10 @@ import json
 
 import pytest
 
-from subapf_planner.bench import main
-from subapf_planner.config import PlannerConfig
-from subapf_planner.episode import run_episode
-from subapf_planner.world import load_world
+from subapf_planner.core.config import PlannerConfig
+from subapf_planner.sim.episode import run_episode
+from subapf_planner.sim.world import load_world
+from subapf_planner.tools.bench import main
 
 KEYS = {'world', 'method', 'outcome', 'time_s', 'path_length', 'min_clearance',
         'mean_abs_curvature', 'plan_ms_median', 'plan_ms_p99', 'cycles'}

@@ -5,8 +5,8 @@ import math
 import numpy as np
 import pytest
 
-from subapf_planner.command import forward_blocked, shape_command
-from subapf_planner.config import PlannerConfig
+from subapf_planner.core.command import forward_blocked, shape_command
+from subapf_planner.core.config import PlannerConfig
 
 CFG = PlannerConfig()
 NONE = np.zeros((0, 2))

@@ -6,7 +6,7 @@ from conftest import PARAMS
 import pytest
 import yaml
 
-from subapf_planner.config import ConfigError, PlannerConfig, from_mapping, load_config
+from subapf_planner.core.config import ConfigError, PlannerConfig, from_mapping, load_config
 
 
 def test_yaml_lists_every_core_parameter_with_its_default():
@@ -49,7 +49,7 @@ def test_bad_params_file(tmp_path):
 
 
 def test_yaml_lists_every_node_parameter_with_its_default():
-    from subapf_planner.planner_node import NODE_PARAMS
+    from subapf_planner.ros.planner_node import NODE_PARAMS
     params = yaml.safe_load(PARAMS.read_text())['subapf_planner']['ros__parameters']
     for name, (default, *_rest) in NODE_PARAMS.items():
         assert name in params, f'{name} missing from config/planner.yaml'

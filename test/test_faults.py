@@ -11,12 +11,12 @@ import rclpy
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.parameter import Parameter
 
-from subapf_planner.config import PlannerConfig
-from subapf_planner.conversions import odom_to_msg, scan_to_msg
-from subapf_planner.episode import Faults, run_episode
-from subapf_planner.planner_node import PlannerNode
-from subapf_planner.simulator import SimConfig
-from subapf_planner.world import load_world, world_files
+from subapf_planner.core.config import PlannerConfig
+from subapf_planner.ros.conversions import odom_to_msg, scan_to_msg
+from subapf_planner.ros.planner_node import PlannerNode
+from subapf_planner.sim.episode import Faults, run_episode
+from subapf_planner.sim.simulator import SimConfig
+from subapf_planner.sim.world import load_world, world_files
 
 FIG6 = ('fig6a_narrow_obstacles', 'fig6b_tight_space', 'fig6c_circle_in_front',
         'fig6d_big_wall')
@@ -56,7 +56,7 @@ def node_and_clock():
 @pytest.mark.parametrize('stream', ['scan', 'odom'])
 def test_stale_input_stops_within_one_period_of_its_timeout(stream):
     """The controller on a 5 Hz tick: zero velocity at the first tick past the timeout."""
-    from subapf_planner.controller import PlannerController, ScanInput, Supervision
+    from subapf_planner.core.controller import PlannerController, ScanInput, Supervision
     ctl = PlannerController(PlannerConfig(), Supervision(scan_timeout=0.5, odom_timeout=0.5))
     ctl.set_goal(np.array([3.0, 0.0]))
     scan = ScanInput(np.full(360, np.inf), 0.0, math.pi / 180, 0.12, 3.5, 0.0)
@@ -118,7 +118,7 @@ def test_stream_stops_then_resumes(node_and_clock, stream):
 
 
 def test_clock_jump_resets_inputs_but_keeps_the_goal():
-    from subapf_planner.controller import PlannerController, ScanInput
+    from subapf_planner.core.controller import PlannerController, ScanInput
     ctl = PlannerController(PlannerConfig())
     ctl.set_goal(np.array([3.0, 0.0]))
     ctl.update_scan(ScanInput(np.full(360, np.inf), 0.0, math.pi / 180, 0.12, 3.5, 50.0), 50.0)

@@ -11,16 +11,16 @@ from conftest import PARAMS, WORLDS
 import numpy as np
 import pytest
 
-from subapf_planner.config import PlannerConfig
-from subapf_planner.episode import run_episode
-from subapf_planner.world import load_world
+from subapf_planner.core.config import PlannerConfig
+from subapf_planner.sim.episode import run_episode
+from subapf_planner.sim.world import load_world
 
 
 def bringup(tmp_path: Path, world: str, domain: int, *extra: str, timeout: float = 240):
     env = dict(os.environ, ROS_AUTOMATIC_DISCOVERY_RANGE='LOCALHOST',
                ROS_DOMAIN_ID=str(domain))
     return subprocess.run(
-        [sys.executable, '-m', 'subapf_planner.bringup', '--world', str(WORLDS / world),
+        [sys.executable, '-m', 'subapf_planner.tools.bringup', '--world', str(WORLDS / world),
          '--rate', '5', '--domain-id', str(domain), '--png', str(tmp_path / 'run.png'),
          *extra], env=env, capture_output=True, text=True, timeout=timeout, cwd=tmp_path)
 
@@ -63,20 +63,20 @@ def check_bag_with_rosbags(bag: Path, outcome: bool = True):
 def test_bad_world_and_bad_parameters_exit_with_clear_errors(tmp_path):
     bad = tmp_path / 'bad.yaml'
     bad.write_text('name: x\nstart: [0, 0]\ngoal: [1, 1]\n')
-    r = subprocess.run([sys.executable, '-m', 'subapf_planner.bringup', '--world', str(bad)],
+    r = subprocess.run([sys.executable, '-m', 'subapf_planner.tools.bringup', '--world', str(bad)],
                        capture_output=True, text=True, timeout=60)
     assert r.returncode == 2 and 'start: expected a list of 3 numbers' in r.stderr
-    r = subprocess.run([sys.executable, '-m', 'subapf_planner.bringup', '--world',
+    r = subprocess.run([sys.executable, '-m', 'subapf_planner.tools.bringup', '--world',
                         str(WORLDS / 'u_trap.yaml'), '--domain-id', '500'],
                        capture_output=True, text=True, timeout=60)
     assert r.returncode == 2 and '--domain-id must be in [0, 101]' in r.stderr
     env = dict(os.environ, ROS_AUTOMATIC_DISCOVERY_RANGE='LOCALHOST', ROS_DOMAIN_ID='73')
-    r = subprocess.run([sys.executable, '-m', 'subapf_planner.planner_node', '--ros-args',
+    r = subprocess.run([sys.executable, '-m', 'subapf_planner.ros.planner_node', '--ros-args',
                         '--params-file', str(PARAMS), '-p', 'method:=teleport'],
                        capture_output=True, text=True, timeout=60, env=env)
     assert r.returncode == 2 and "method: 'teleport' is not one of" in r.stderr
     for bad in ('danger_distance:=5.0', 'danger_distance:=wide', 'num_samples:=2.5'):
-        r = subprocess.run([sys.executable, '-m', 'subapf_planner.planner_node', '--ros-args',
+        r = subprocess.run([sys.executable, '-m', 'subapf_planner.ros.planner_node', '--ros-args',
                             '-p', bad], capture_output=True, text=True, timeout=60, env=env)
         assert r.returncode == 2 and bad.split(':=')[0] in r.stderr, (bad, r.stderr)
         assert 'Traceback' not in r.stderr
@@ -85,8 +85,8 @@ def test_bad_world_and_bad_parameters_exit_with_clear_errors(tmp_path):
 def test_standalone_recorder_finalises_on_sigint_and_replays(tmp_path):
     env = dict(os.environ, ROS_AUTOMATIC_DISCOVERY_RANGE='LOCALHOST', ROS_DOMAIN_ID='75')
     bag = tmp_path / 'rec.mcap'
-    rec = subprocess.Popen([sys.executable, '-m', 'subapf_planner.record', '--topics', '/scan',
-                            '/odom', '/cmd_vel', '/goal_pose', '/clock', '-o', str(bag)],
+    rec = subprocess.Popen([sys.executable, '-m', 'subapf_planner.tools.record', '--topics',
+                            '/scan', '/odom', '/cmd_vel', '/goal_pose', '/clock', '-o', str(bag)],
                            env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     try:
         result = bringup(tmp_path, 'fig6c_circle_in_front.yaml', 75)
@@ -97,7 +97,7 @@ def test_standalone_recorder_finalises_on_sigint_and_replays(tmp_path):
     assert rec.returncode == 0, err
     assert 'messages in' in out
     check_bag_with_rosbags(bag, outcome=False)
-    r = subprocess.run([sys.executable, '-m', 'subapf_planner.replay', str(bag),
+    r = subprocess.run([sys.executable, '-m', 'subapf_planner.tools.replay', str(bag),
                         '--tolerance', '1e-9'], capture_output=True, text=True, timeout=120)
     assert r.returncode in (0, 1), r.stdout + r.stderr
     # A recorder in another process sees the inputs in its own order, not always in the
@@ -110,8 +110,8 @@ def test_standalone_recorder_finalises_on_sigint_and_replays(tmp_path):
 
 def test_short_soak_reports_and_passes(tmp_path):
     env = dict(os.environ, ROS_AUTOMATIC_DISCOVERY_RANGE='LOCALHOST')
-    r = subprocess.run([sys.executable, '-m', 'subapf_planner.soak', '--runs', '1', '--rate', '2',
-                        '--worlds',
+    r = subprocess.run([sys.executable, '-m', 'subapf_planner.tools.soak', '--runs', '1',
+                        '--rate', '2', '--worlds',
                         str(WORLDS / 'fig6c_circle_in_front.yaml'), '--out', str(tmp_path)],
                        capture_output=True, text=True, timeout=240, env=env)
     assert r.returncode == 0, r.stdout + r.stderr
@@ -141,7 +141,7 @@ def test_bringup_interrupted_stops_everything_and_finalises_the_bag(tmp_path, si
     domain = 79 if sig == signal.SIGINT else 80
     bag = tmp_path / 'cut.mcap'
     env = dict(os.environ, ROS_AUTOMATIC_DISCOVERY_RANGE='LOCALHOST', ROS_DOMAIN_ID=str(domain))
-    p = subprocess.Popen([sys.executable, '-m', 'subapf_planner.bringup', '--world',
+    p = subprocess.Popen([sys.executable, '-m', 'subapf_planner.tools.bringup', '--world',
                           str(WORLDS / 'fig6d_big_wall.yaml'), '--domain-id', str(domain),
                           '--record', str(bag), '--png', str(tmp_path / 'p.png')],
                          env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)

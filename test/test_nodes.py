@@ -15,8 +15,8 @@ from rclpy.qos import qos_profile_sensor_data
 from sensor_msgs.msg import LaserScan
 from std_msgs.msg import String
 
-from subapf_planner.conversions import odom_to_msg, scan_to_msg
-from subapf_planner.planner_node import PlannerNode
+from subapf_planner.ros.conversions import odom_to_msg, scan_to_msg
+from subapf_planner.ros.planner_node import PlannerNode
 
 os.environ['ROS_DOMAIN_ID'] = str(60 + os.getpid() % 40)
 

@@ -7,7 +7,7 @@ from hypothesis import strategies as st
 import numpy as np
 import pytest
 
-from subapf_planner.potentials import (
+from subapf_planner.core.potentials import (
     attractive_gradient,
     attractive_value,
     max_subharmonic_slope,

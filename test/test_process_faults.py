@@ -11,9 +11,9 @@ import rclpy
 from rclpy.executors import SingleThreadedExecutor
 from std_msgs.msg import String
 
-from subapf_planner.conversions import stamp_to_seconds
-from subapf_planner.processes import join_domain, start, stop
-from subapf_planner.sim_node import LATCHED
+from subapf_planner.ros.conversions import stamp_to_seconds
+from subapf_planner.ros.processes import join_domain, start, stop
+from subapf_planner.ros.sim_node import LATCHED
 
 WORLD = WORLDS / 'fig6d_big_wall.yaml'
 

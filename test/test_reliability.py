@@ -14,12 +14,12 @@ import rclpy
 from rclpy.parameter import Parameter
 from sensor_msgs.msg import LaserScan
 
-from subapf_planner.command import forward_blocked
-from subapf_planner.config import METHODS, PlannerConfig
-from subapf_planner.controller import PlannerController, ScanInput
-from subapf_planner.planner import Planner, plan
-from subapf_planner.planner_node import PlannerNode
-from subapf_planner.scan import geometry_warning
+from subapf_planner.core.command import forward_blocked
+from subapf_planner.core.config import METHODS, PlannerConfig
+from subapf_planner.core.controller import PlannerController, ScanInput
+from subapf_planner.core.planner import Planner, plan
+from subapf_planner.core.scan import geometry_warning
+from subapf_planner.ros.planner_node import PlannerNode
 
 CFG = PlannerConfig()
 weird = st.one_of(st.floats(-10, 10), st.sampled_from([math.nan, math.inf, -math.inf, 0.0]))
@@ -249,8 +249,8 @@ def test_goal_behind_a_wall_without_progress_becomes_stuck():
 
 
 def test_tf_frames_follow_rep105():
-    from subapf_planner.conversions import transform_msg
-    from subapf_planner.sim_node import BASE_LINK_HEIGHT, LASER_IN_BASE_LINK
+    from subapf_planner.ros.conversions import transform_msg
+    from subapf_planner.ros.sim_node import BASE_LINK_HEIGHT, LASER_IN_BASE_LINK
     t = transform_msg('odom', 'base_footprint', (1.0, 2.0, 0.0), math.pi / 2, 3.5)
     assert (t.header.frame_id, t.child_frame_id) == ('odom', 'base_footprint')
     assert t.transform.rotation.z == pytest.approx(math.sqrt(0.5))

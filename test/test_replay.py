@@ -7,8 +7,8 @@ from mcap.writer import Writer
 import numpy as np
 import pytest
 
-from subapf_planner.bag import BagError, read, topics
-from subapf_planner.replay import main as replay_main
+from subapf_planner.bag.reader import BagError, read, topics
+from subapf_planner.tools.replay import main as replay_main
 
 DATA = REPO / 'test' / 'data'
 BAGS = sorted(DATA.glob('*.mcap'))

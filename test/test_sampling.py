@@ -8,9 +8,14 @@ from hypothesis.extra.numpy import arrays
 import numpy as np
 import pytest
 
-from subapf_planner.apf import apf_force, apf_step
-from subapf_planner.config import PlannerConfig
-from subapf_planner.sampling import circle_samples, clearance, priority_applies, sample_and_choose
+from subapf_planner.core.apf import apf_force, apf_step
+from subapf_planner.core.config import PlannerConfig
+from subapf_planner.core.sampling import (
+    circle_samples,
+    clearance,
+    priority_applies,
+    sample_and_choose,
+)
 
 CFG = PlannerConfig()
 coords = st.floats(-3.0, 3.0, allow_nan=False)

@@ -8,7 +8,7 @@ from hypothesis.extra.numpy import arrays
 import numpy as np
 import pytest
 
-from subapf_planner.scan import ScanError, scan_to_points, valid_beams, voxel_downsample
+from subapf_planner.core.scan import ScanError, scan_to_points, valid_beams, voxel_downsample
 
 ranges_st = arrays(np.float64, st.integers(0, 500),
                    elements=st.one_of(st.floats(allow_nan=True, allow_infinity=True),

@@ -5,8 +5,8 @@ import math
 import numpy as np
 import pytest
 
-from subapf_planner.simulator import LASER_OFFSET, BurgerSim, SimConfig
-from subapf_planner.world import parse_world
+from subapf_planner.sim.simulator import LASER_OFFSET, BurgerSim, SimConfig
+from subapf_planner.sim.world import parse_world
 
 
 def world(obstacles=(), start=(0.0, 0.0, 0.0)):

@@ -3,7 +3,7 @@
 import pytest
 import yaml
 
-from subapf_planner.world import Box, Circle, WorldError, load_world, world_files
+from subapf_planner.sim.world import Box, Circle, WorldError, load_world, world_files
 
 GOOD = """
 name: wall_demo

@@ -15,8 +15,8 @@ import time
 
 import numpy as np
 
-from .config import PlannerConfig
-from .planner import Planner
+from ..core.config import PlannerConfig
+from ..core.planner import Planner
 from .simulator import BurgerSim, SimConfig
 from .world import FOOTPRINT_RADIUS, World
 

@@ -16,9 +16,9 @@ from sensor_msgs.msg import LaserScan
 from std_msgs.msg import String
 from visualization_msgs.msg import MarkerArray
 
+from ..bag.writer import McapRecorder, type_name_of
 from .conversions import pose_from_odom, stamp_to_seconds
 from .processes import rss_mib
-from .recorder import McapRecorder, type_name_of
 from .sim_node import LATCHED
 from .spinning import stop_on_signals
 

@@ -22,9 +22,9 @@ import time
 
 import numpy as np
 
-from .conversions import stamp_to_seconds
+from ..ros.conversions import stamp_to_seconds
+from ..ros.processes import join_domain, rss_mib, start, stop
 from .paths import default_params_file, shipped_worlds_dir
-from .processes import join_domain, rss_mib, start, stop
 
 
 def proc_cpu_seconds(pid: int) -> float:
@@ -40,9 +40,9 @@ def planner_figures(seconds: float, domain: int) -> dict[str, float]:
     from rclpy.qos import qos_profile_sensor_data
     from sensor_msgs.msg import LaserScan
 
-    from .conversions import odom_to_msg, scan_to_msg
-    from .simulator import BurgerSim, SimConfig
-    from .world import load_world
+    from ..ros.conversions import odom_to_msg, scan_to_msg
+    from ..sim.simulator import BurgerSim, SimConfig
+    from ..sim.world import load_world
 
     world = load_world(shipped_worlds_dir() / 'cluttered_field.yaml')
     with BurgerSim(world, SimConfig(range_noise=0.01)) as sim:
@@ -104,8 +104,8 @@ def sim_node_rtf(domain: int) -> float:
     from rosgraph_msgs.msg import Clock
     from std_msgs.msg import String
 
-    from .sim_node import LATCHED
-    from .world import load_world
+    from ..ros.sim_node import LATCHED
+    from ..sim.world import load_world
     env = join_domain(domain)
     world_file = shipped_worlds_dir() / 'fig6d_big_wall.yaml'
     limit = load_world(world_file).time_limit
@@ -136,9 +136,9 @@ def sim_node_rtf(domain: int) -> float:
 
 
 def episode_rtf() -> float:
-    from .config import PlannerConfig
-    from .episode import run_episode
-    from .world import load_world
+    from ..core.config import PlannerConfig
+    from ..sim.episode import run_episode
+    from ..sim.world import load_world
     world = load_world(shipped_worlds_dir() / 'fig6d_big_wall.yaml')
     t0 = time.perf_counter()
     result = run_episode(world, PlannerConfig())

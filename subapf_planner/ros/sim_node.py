@@ -25,6 +25,8 @@ from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import LaserScan
 from std_msgs.msg import String
 
+from ..sim.simulator import LASER_OFFSET, BurgerSim, SimConfig
+from ..sim.world import WorldError, load_world
 from .conversions import (
     cmd_from_msg,
     odom_to_msg,
@@ -34,9 +36,7 @@ from .conversions import (
     transform_msg,
 )
 from .planner_node import descriptor
-from .simulator import LASER_OFFSET, BurgerSim, SimConfig
 from .spinning import spin_node
-from .world import WorldError, load_world
 
 #: Simulated time per timer tick [s]; odometry and /clock go out every tick.
 TICK = 0.05

@@ -11,7 +11,7 @@ matplotlib.use('Agg')
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from .world import World, obstacle_outline  # noqa: E402
+from ..sim.world import World, obstacle_outline  # noqa: E402
 
 METHOD_STYLE = {
     'subharmonic_sampling': ('tab:red', 'subharmonic + sampling'),

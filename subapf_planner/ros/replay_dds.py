@@ -25,10 +25,10 @@ from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import LaserScan
 from std_msgs.msg import String
 
-from .bag import BagError, read
+from ..bag.reader import BagError, read
+from ..tools.replay import Comparison, check_topics
 from .conversions import cmd_from_msg, seconds_to_stamp, stamp_to_seconds
 from .processes import join_domain, start, stop
-from .replay import Comparison, check_topics
 
 #: Longest wait for the node's answer to one tick [s].
 ANSWER_TIMEOUT = 5.0

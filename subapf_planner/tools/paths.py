@@ -18,7 +18,7 @@ def _share_candidates() -> list[Path]:
     for prefix in filter(None, os.environ.get('AMENT_PREFIX_PATH', '').split(os.pathsep)):
         out.append(Path(prefix) / 'share' / PACKAGE)
     out.append(Path(sys.prefix) / 'share' / PACKAGE)
-    out.append(Path(__file__).resolve().parents[1])  # source checkout: sim/, config/
+    out.append(Path(__file__).resolve().parents[2])  # source checkout: sim/, config/
     return out
 
 

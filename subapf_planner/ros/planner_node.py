@@ -8,7 +8,7 @@ Topics (relative, so namespaces and remapping work):
        "state: reason"), ~/markers (visualization_msgs/MarkerArray)
 
 The node only translates messages and parameters and drives one timer; the
-planning is subapf_planner.planner.
+planning is subapf_planner.core.planner.
 """
 
 from __future__ import annotations
@@ -33,8 +33,9 @@ from sensor_msgs.msg import LaserScan
 from std_msgs.msg import String
 from visualization_msgs.msg import MarkerArray
 
-from .config import ConfigError, PlannerConfig, field_specs, from_mapping
-from .controller import PlannerController, Supervision
+from ..core.config import ConfigError, PlannerConfig, field_specs, from_mapping
+from ..core.controller import PlannerController, Supervision
+from ..core.scan import geometry_warning
 from .conversions import (
     cmd_to_msg,
     markers_from_result,
@@ -42,7 +43,6 @@ from .conversions import (
     scan_from_msg,
     stamp_to_seconds,
 )
-from .scan import geometry_warning
 from .spinning import spin_node
 
 NODE_NAME = 'subapf_planner'

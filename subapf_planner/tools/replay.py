@@ -18,12 +18,18 @@ import sys
 
 import numpy as np
 
-from .bag import BagError, read, topics
-from .config import METHODS, ConfigError, PlannerConfig, load_config, load_params_file
-from .controller import PlannerController, Supervision
-from .conversions import cmd_from_msg, cmd_to_msg, pose_from_odom, scan_from_msg, stamp_to_seconds
+from ..bag.reader import BagError, read, topics
+from ..bag.writer import McapRecorder
+from ..core.config import METHODS, ConfigError, PlannerConfig, load_config, load_params_file
+from ..core.controller import PlannerController, Supervision
+from ..ros.conversions import (
+    cmd_from_msg,
+    cmd_to_msg,
+    pose_from_odom,
+    scan_from_msg,
+    stamp_to_seconds,
+)
 from .paths import default_params_file
-from .recorder import McapRecorder
 
 INPUTS = {'scan': 'sensor_msgs/msg/LaserScan', 'odom': 'nav_msgs/msg/Odometry',
           'goal': 'geometry_msgs/msg/PoseStamped'}
@@ -124,7 +130,7 @@ def write_commands(out: str, comparison: Comparison) -> None:
     """The replayed commands as /cmd_vel (TwistStamped) in an MCAP file."""
     from rclpy.serialization import serialize_message
 
-    from .conversions import seconds_to_stamp
+    from ..ros.conversions import seconds_to_stamp
     rec = McapRecorder(out)
     try:
         rec.add_topic('/cmd_vel', CMD_TYPES[0])
@@ -162,7 +168,7 @@ def main(argv: list[str] | None = None) -> int:
         names = {'scan': args.scan_topic, 'odom': args.odom_topic, 'goal': args.goal_topic,
                  'cmd_vel': args.cmd_topic}
         if args.through_node:
-            from .replay_dds import replay_through_node
+            from ..ros.replay_dds import replay_through_node
             domain = args.domain_id if args.domain_id is not None else random.randint(1, 100)
             comparison = replay_through_node(args.bag, str(params), names, args.method, domain)
         else:

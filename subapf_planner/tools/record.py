@@ -18,9 +18,9 @@ from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from rclpy.signals import SignalHandlerOptions
 
-from .bag import BagError, message_class
-from .recorder import McapRecorder, RecorderError
-from .spinning import stop_on_signals
+from ..bag.reader import BagError, message_class
+from ..bag.writer import McapRecorder, RecorderError
+from ..ros.spinning import stop_on_signals
 
 DEPTH = 500
 

@@ -12,9 +12,9 @@ from sensor_msgs.msg import LaserScan
 from std_msgs.msg import ColorRGBA
 from visualization_msgs.msg import Marker, MarkerArray
 
-from .controller import ScanInput
-from .planner import PlanResult
-from .scan import voxel_downsample
+from ..core.controller import ScanInput
+from ..core.planner import PlanResult
+from ..core.scan import voxel_downsample
 
 
 def stamp_to_seconds(stamp: Time) -> float:

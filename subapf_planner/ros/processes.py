@@ -34,7 +34,7 @@ def start(module: str, ros_args: list[str], env: dict[str, str], quiet: bool = F
         out = None
         pipes = dict(stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL) if quiet else {}
     try:
-        return subprocess.Popen([sys.executable, '-m', f'subapf_planner.{module}',
+        return subprocess.Popen([sys.executable, '-m', f'subapf_planner.ros.{module}',
                                  '--ros-args', *ros_args], env=env, start_new_session=True,
                                 **pipes)
     finally:

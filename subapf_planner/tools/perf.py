@@ -12,11 +12,11 @@ import time
 
 import numpy as np
 
-from .config import METHODS, load_config
+from ..core.config import METHODS, load_config
+from ..core.planner import Planner
+from ..sim.simulator import BurgerSim, SimConfig
+from ..sim.world import load_world
 from .paths import default_params_file, shipped_worlds_dir
-from .planner import Planner
-from .simulator import BurgerSim, SimConfig
-from .world import load_world
 
 
 def main(argv: list[str] | None = None) -> int:

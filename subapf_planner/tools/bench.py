@@ -19,12 +19,12 @@ import time
 import numpy as np
 from tqdm import tqdm
 
-from .config import METHODS, ConfigError, PlannerConfig, load_config
-from .episode import Faults, run_episode
+from ..core.config import METHODS, ConfigError, PlannerConfig, load_config
+from ..sim.episode import Faults, run_episode
+from ..sim.simulator import SimConfig
+from ..sim.world import WorldError, load_world, world_files
 from .paths import default_params_file, shipped_worlds_dir
 from .plots import plot_trajectories
-from .simulator import SimConfig
-from .world import WorldError, load_world, world_files
 
 
 def _run(job: tuple[str, str, PlannerConfig, SimConfig, Faults]) -> tuple[dict, list]:

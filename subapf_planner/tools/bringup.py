@@ -18,11 +18,11 @@ import sys
 
 import numpy as np
 
-from .config import METHODS, load_config
-from .episode import path_length
+from ..core.config import METHODS, load_config
+from ..ros.processes import join_domain, start, stop
+from ..sim.episode import path_length
+from ..sim.world import World, WorldError, load_world
 from .paths import default_params_file
-from .processes import join_domain, start, stop
-from .world import World, WorldError, load_world
 
 
 def parse_args(argv: list[str] | None) -> argparse.Namespace:
@@ -73,7 +73,7 @@ def run_once(world: World, world_path: str, params: str, domain: int, *,
         sim_args += ['-p', f'{name}:={value}']
     timeout = timeout or 2.0 * world.time_limit / rate + 30.0
 
-    from .supervisor import Supervisor  # rclpy only after the environment is set
+    from ..ros.supervisor import Supervisor  # rclpy only after the environment is set
     children: list[subprocess.Popen] = []
     sup = None
     logs = {name: (log_dir / f'{name}.log' if log_dir else None) for name in ('sim', 'planner')}
@@ -107,7 +107,7 @@ def main(argv: list[str] | None = None) -> int:
     if args.domain_id is not None and not 0 <= args.domain_id <= 101:
         print('subapf-bringup: --domain-id must be in [0, 101]', file=sys.stderr)
         return 2
-    from .supervisor import RECORDED
+    from ..ros.supervisor import RECORDED
     unknown = sorted(set(args.record_topics or ()) - set(RECORDED))
     if unknown:
         print(f'subapf-bringup: cannot record {unknown}; choose from {list(RECORDED)}',
