@@ -6,6 +6,7 @@ import pytest
 
 from subapf_planner.core.config import PlannerConfig
 from subapf_planner.sim.episode import run_episode
+from subapf_planner.sim.simulator import SimConfig
 from subapf_planner.sim.world import load_world
 from subapf_planner.tools.bench import main
 
@@ -23,7 +24,7 @@ def test_short_bench_writes_consistent_results(tmp_path, worlds_dir):
     assert len(runs) == 4
     for r in runs:
         assert KEYS <= set(r)
-        assert r['outcome'] in ('reached', 'collision', 'timeout')
+        assert r['outcome'] in ('reached', 'collision', 'timeout', 'abandoned')
         if r['outcome'] == 'reached':
             assert r['final_distance'] <= r['goal_tolerance']
             straight = 5.0 if r['world'] == 'four_points' else 4.0
@@ -49,7 +50,8 @@ def test_bench_rejects_unknown_method_and_bad_world(tmp_path, capsys):
 @pytest.mark.parametrize('name', ['fig6c_circle_in_front', 'fig6d_big_wall'])
 def test_only_sampling_passes_the_local_minima(worlds_dir, name):
     world = load_world(worlds_dir / f'{name}.yaml')
-    outcomes = {m: run_episode(world, PlannerConfig(method=m)).outcome
+    quiet = SimConfig(range_noise=0.0)   # with noise, 6c's symmetric minimum breaks by luck
+    outcomes = {m: run_episode(world, PlannerConfig(method=m), quiet).outcome
                 for m in ('subharmonic_sampling', 'subharmonic', 'traditional', 'harmonic')}
     assert outcomes['subharmonic_sampling'] == 'reached'
     assert all(outcomes[m] != 'reached' for m in ('subharmonic', 'traditional', 'harmonic'))

@@ -48,11 +48,21 @@ def test_bad_params_file(tmp_path):
         load_config(bad)
 
 
+def test_yaml_is_what_the_metadata_writes():
+    """config/planner.yaml documents every parameter of both nodes, as the code declares
+    them (regenerate: python -m subapf_planner.tools.paramdoc config/planner.yaml)."""
+    from subapf_planner.tools.paramdoc import render
+    assert PARAMS.read_text() == render()
+
+
 def test_yaml_lists_every_node_parameter_with_its_default():
-    from subapf_planner.ros.planner_node import NODE_PARAMS
-    params = yaml.safe_load(PARAMS.read_text())['subapf_planner']['ros__parameters']
-    for name, (default, *_rest) in NODE_PARAMS.items():
-        assert name in params, f'{name} missing from config/planner.yaml'
-        assert params[name] == default, name
-    core = {f.name for f in dataclasses.fields(PlannerConfig)}
-    assert set(params) == core | set(NODE_PARAMS)
+    from subapf_planner.ros.planner_node import GROUPS
+    from subapf_planner.ros.sim_node import GROUPS as SIM_GROUPS
+    doc = yaml.safe_load(PARAMS.read_text())
+    for node, groups in (('subapf_planner', GROUPS), ('subapf_sim', SIM_GROUPS)):
+        params = doc[node]['ros__parameters']
+        fields = [f for g in groups for f in dataclasses.fields(g)]
+        assert set(params) == {f.name for f in fields}
+        for f in fields:
+            assert params[f.name] == f.default and type(params[f.name]) is type(f.default), \
+                f.name

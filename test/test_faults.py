@@ -14,7 +14,8 @@ from rclpy.parameter import Parameter
 from subapf_planner.core.config import PlannerConfig
 from subapf_planner.ros.conversions import odom_to_msg, scan_to_msg
 from subapf_planner.ros.planner_node import PlannerNode
-from subapf_planner.sim.episode import Faults, run_episode
+from subapf_planner.sim.episode import run_episode
+from subapf_planner.sim.faults import ScanDelivery, ScanFaults
 from subapf_planner.sim.simulator import SimConfig
 from subapf_planner.sim.world import load_world, world_files
 
@@ -27,7 +28,7 @@ def test_lost_and_late_scans_never_cause_a_collision(path):
     world = load_world(path)
     result = run_episode(world, PlannerConfig(),
                          SimConfig(range_noise=0.01, beam_dropout=0.05, seed=5),
-                         faults=Faults(scan_dropout=0.3, scan_delay=2))
+                         faults=ScanFaults(scan_dropout=0.3, scan_latency=0.4))
     assert result.outcome != 'collision'
     if world.name in FIG6:
         assert result.outcome == 'reached'
@@ -35,7 +36,21 @@ def test_lost_and_late_scans_never_cause_a_collision(path):
 
 def test_bad_fault_values():
     with pytest.raises(ValueError, match='scan_dropout'):
-        Faults(scan_dropout=1.0)
+        ScanFaults(scan_dropout=1.0)
+    with pytest.raises(ValueError, match='scan_latency'):
+        ScanFaults(scan_latency=-0.1)
+
+
+def test_scan_delivery_loses_and_delays_as_configured():
+    late = ScanDelivery(ScanFaults(scan_latency=0.4), seed=1)
+    for k in range(5):
+        late.capture(k, 0.2 * k)
+    assert late.due(0.39) == [] and late.due(0.4) == [0] and late.due(1.2) == [1, 2, 3, 4]
+    lossy = ScanDelivery(ScanFaults(scan_dropout=0.3), seed=2)
+    for k in range(2000):
+        lossy.capture(k, 0.0)
+    kept = len(lossy.due(0.0))
+    assert 0.65 * 2000 < kept < 0.75 * 2000   # binomial sd ~ 20
 
 
 @pytest.fixture
@@ -111,10 +126,10 @@ def test_stream_stops_then_resumes(node_and_clock, stream):
     stops = [t for t, v, w in sent if t > last_input['t'] and v == 0.0 and w == 0.0]
     assert stops, 'no zero command after the stream stopped'
     assert stops[0] - last_input['t'] <= 0.5 + 3 * node.cfg.period
-    assert node.ctl.state == f'stopped: {"scan" if stream == "scan" else "odometry"} is stale'
+    assert node.ctl.text == f'stopped: {"scan" if stream == "scan" else "odometry"} is stale'
     assert all(v == 0.0 for t, v, _ in sent if t > stops[0])
     run(1.0)
-    assert sent[-1][1] > 0.0 and node.ctl.state.startswith('driving')   # no restart needed
+    assert sent[-1][1] > 0.0 and node.ctl.text.startswith('driving')   # no restart needed
 
 
 def test_clock_jump_resets_inputs_but_keeps_the_goal():
@@ -126,5 +141,5 @@ def test_clock_jump_resets_inputs_but_keeps_the_goal():
     assert ctl.tick(50.0).command[0] > 0
     ctl.clock_jumped()
     d = ctl.tick(0.2)
-    assert d.command is None and d.state == 'waiting: no scan yet'
+    assert d.command is None and d.text == 'waiting: no scan yet'
     assert ctl.goal is not None

@@ -153,20 +153,20 @@ FREE = [math.inf] * 360
 def test_wrong_frame_scan_is_dropped(node):
     node.ctl.scan = None
     d = drive(node, scan_msg(FREE, 0.0, math.pi / 180, 0.12, 3.5, 'laser'))
-    assert d.command is None and d.state == 'waiting: no scan yet'
+    assert d.command is None and d.text == 'waiting: no scan yet'
 
 
 @pytest.mark.parametrize('inc', [0.0, -0.01, math.nan])
 def test_bad_angle_increment_stops(node, inc):
     d = drive(node, scan_msg([1.0] * 10, 0.0, inc, 0.12, 3.5, 'base_scan'))
-    assert d.command == (0.0, 0.0) and d.state == 'stopped: invalid_scan'
+    assert d.command == (0.0, 0.0) and d.text == 'stopped: invalid_scan'
 
 
 def test_nan_angle_min_with_finite_angle_max_stops(node):
     msg = scan_msg([1.0] * 10, math.nan, 0.01, 0.12, 3.5, 'base_scan', angle_max=1.0)
     assert geometry_warning(10, math.nan, 1.0, 0.01) is None
     d = drive(node, msg)
-    assert d.command == (0.0, 0.0) and d.state == 'stopped: invalid_scan'
+    assert d.command == (0.0, 0.0) and d.text == 'stopped: invalid_scan'
 
 
 def test_length_mismatch_and_intensities_do_not_matter(node):
@@ -174,13 +174,13 @@ def test_length_mismatch_and_intensities_do_not_matter(node):
     msg.intensities = [1.0, 2.0]
     assert geometry_warning(360, 0.0, 1.0, math.pi / 180) is not None
     d = drive(node, msg)
-    assert d.state.startswith('driving') and d.command[0] >= 0.0
+    assert d.text.startswith('driving') and d.command[0] >= 0.0
 
 
 def test_all_inf_and_empty_scans_are_open_space(node):
     assert drive(node, scan_msg(FREE, 0.0, math.pi / 180, 0.12, 3.5, 'base_scan')
-                 ).state.startswith('driving')
-    assert drive(node, scan_msg([], 0.0, 0.0, 0.12, 3.5, 'base_scan')).state.startswith(
+                 ).text.startswith('driving')
+    assert drive(node, scan_msg([], 0.0, 0.0, 0.12, 3.5, 'base_scan')).text.startswith(
         'driving')
 
 
@@ -195,7 +195,7 @@ def test_nan_pose_dropped_and_quaternion_normalised(node):
     node.ctl.pose = None
     d = drive(node, scan_msg(FREE, 0.0, math.pi / 180, 0.12, 3.5, 'base_scan'),
               pose=(math.nan, 0.0))
-    assert d.command is None and d.state == 'waiting: no odom yet'
+    assert d.command is None and d.text == 'waiting: no odom yet'
     drive(node, scan_msg(FREE, 0.0, math.pi / 180, 0.12, 3.5, 'base_scan'),
           q=(0.0, 0.0, 2.0, 2.0))   # |q| = 2.8: yaw pi/2 after normalising
     assert node.ctl.pose[2] == pytest.approx(math.pi / 2)
@@ -223,7 +223,7 @@ def test_goal_inside_obstacle_stops_with_reason():
     ctl.update_scan(ScanInput(ranges, 0.0, math.pi / 180, 0.12, 3.5, 0.0), 0.0)
     ctl.update_odom(0.0, np.zeros(3), 0.0)
     d = ctl.tick(0.0)
-    assert d.command == (0.0, 0.0) and d.state == 'stopped: goal_in_obstacle'
+    assert d.command == (0.0, 0.0) and d.text == 'stopped: goal_in_obstacle'
 
 
 def test_goal_equal_to_start_is_reached_at_once():
@@ -231,7 +231,7 @@ def test_goal_equal_to_start_is_reached_at_once():
     ctl.set_goal(np.array([0.0, 0.0]))
     ctl.update_scan(ScanInput(np.full(360, np.inf), 0.0, math.pi / 180, 0.12, 3.5, 0.0), 0.0)
     ctl.update_odom(0.0, np.zeros(3), 0.0)
-    assert ctl.tick(0.0).state.startswith('reached') and ctl.goal is None
+    assert ctl.tick(0.0).text.startswith('reached') and ctl.goal is None
 
 
 def test_goal_behind_a_wall_without_progress_becomes_stuck():
@@ -243,7 +243,7 @@ def test_goal_behind_a_wall_without_progress_becomes_stuck():
     for k in range(20):   # the robot does not move (pose fixed): no progress
         ctl.update_scan(scan, 0.2 * k)
         ctl.update_odom(0.2 * k, np.array([0.0, 0.0, math.pi / 2]), 0.2 * k)
-        states.append(ctl.tick(0.2 * k).state)
+        states.append(ctl.tick(0.2 * k).text)
     assert states[-1] == 'stuck: no progress, goal abandoned'
     assert ctl.tick(4.0).command == (0.0, 0.0)
 

@@ -36,7 +36,7 @@ def test_rotation_covers_w_times_t():
 
 def test_lidar_range_to_known_box():
     box = {'box': {'center': [2.0, 0.0], 'size': [0.2, 2.0]}}
-    with BurgerSim(world([box])) as sim:
+    with BurgerSim(world([box]), SimConfig(range_noise=0.0)) as sim:
         scan = sim.scan()
     face = 2.0 - 0.1 - LASER_OFFSET[0]
     assert scan.ranges[0] == pytest.approx(face, abs=1e-3)

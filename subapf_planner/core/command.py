@@ -18,6 +18,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from .config import PlannerConfig
+from .status import Status
 
 
 @dataclass(frozen=True)
@@ -26,7 +27,7 @@ class Command:
 
     v: float
     w: float
-    status: str  # driving, turning, reached, blocked_ahead, no_safe_move
+    status: Status
 
 
 def wrap_angle(a: float) -> float:
@@ -63,27 +64,27 @@ def shape_command(pose: ArrayLike, target: ArrayLike | None, goal: ArrayLike,
     gx, gy = (float(v) for v in goal)
     dist_goal = math.hypot(gx - x, gy - y)
     if dist_goal <= cfg.goal_tolerance:
-        return Command(0.0, 0.0, 'reached')
+        return Command(0.0, 0.0, Status.REACHED)
     if target is None:
-        return Command(0.0, 0.0, 'no_safe_move')
+        return Command(0.0, 0.0, Status.NO_SAFE_MOVE)
     tx, ty = (float(v) for v in target)
     dist = math.hypot(tx - x, ty - y)
     alpha = wrap_angle(math.atan2(ty - y, tx - x) - yaw) if dist > 1e-9 else 0.0
     w = float(np.clip(cfg.heading_gain * alpha, -cfg.max_angular_velocity,
                       cfg.max_angular_velocity))
     if abs(alpha) > cfg.rotate_in_place_angle:
-        v, status = 0.0, 'turning'
+        v, status = 0.0, Status.TURNING
     else:
         slow = 1.0
         if cfg.slowdown_distance > 0.0:
             slow = min(1.0, max(0.25, dist_goal / cfg.slowdown_distance))
         v = min(cfg.max_linear_velocity * slow, dist / cfg.period) * math.cos(alpha)
-        v, status = max(v, 0.0), 'driving'
+        v, status = max(v, 0.0), Status.DRIVING
     v_prev, w_prev = previous
     v = _rate_limit(v, v_prev, cfg.max_linear_acceleration, cfg.period)
     w = _rate_limit(w, w_prev, cfg.max_angular_acceleration, cfg.period)
     v = min(max(v, 0.0), cfg.max_linear_velocity)
     w = float(np.clip(w, -cfg.max_angular_velocity, cfg.max_angular_velocity))
     if v > 0.0 and forward_blocked(pose, obstacles, cfg):
-        v, status = 0.0, 'blocked_ahead'
+        v, status = 0.0, Status.BLOCKED_AHEAD
     return Command(v, w, status)

@@ -9,26 +9,18 @@ apart (``test/test_config.py`` checks the YAML against this module).
 from __future__ import annotations
 
 import dataclasses
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 import math
 from pathlib import Path
 from typing import Any, Mapping
 
 import yaml
 
+from .params import ConfigError, build, check_fields, param
+
 #: Repulsive potentials of the paper, plus the Dynamic Window baseline.
 APF_METHODS = ('subharmonic_sampling', 'subharmonic', 'traditional', 'harmonic')
 METHODS = APF_METHODS + ('dwa',)
-
-
-class ConfigError(ValueError):
-    """A configuration value is missing, of the wrong type or out of range."""
-
-
-def _param(default: Any, description: str, unit: str = '', lo: float | None = None,
-           hi: float | None = None, choices: tuple[str, ...] | None = None) -> Any:
-    meta = {'description': description, 'unit': unit, 'lo': lo, 'hi': hi, 'choices': choices}
-    return field(default=default, metadata=meta)
 
 
 @dataclass(frozen=True)
@@ -36,77 +28,76 @@ class PlannerConfig:
     """All parameters of the planner core; see README 'Parameters'."""
 
     # --- method and potentials (paper Sections II-III) ---------------------------------
-    method: str = _param('subharmonic_sampling', "Planner: the paper's full method, "
+    method: str = param('subharmonic_sampling', "Planner: the paper's full method, "
                          'its ablations, or the DWA baseline', choices=METHODS)
-    attraction: str = _param('conic', 'Attractive potential: quadratic a_att*r^2 (eq. 21) or '
+    attraction: str = param('conic', 'Attractive potential: quadratic a_att*r^2 (eq. 21) or '
                              'conic a_att*r (constant-magnitude pull, what Section II-C '
                              'asks of the goal field)', choices=('conic', 'quadratic'))
-    attraction_gain: float = _param(1.0, 'a_att of eq. (21)', '1/m (quadratic) or - (conic)',
+    attraction_gain: float = param(1.0, 'a_att of eq. (21)', '1/m (quadratic) or - (conic)',
                                     0.0, 100.0)
-    repulsion_gain: float = _param(0.5, 'a of eq. (13); scale of the 1/r and -log10 r '
+    repulsion_gain: float = param(0.5, 'a of eq. (13); scale of the 1/r and -log10 r '
                                    'repulsions too', 'm (1/r), - (others)', 0.0, 100.0)
-    danger_distance: float = _param(0.25, 'd0 of eq. (20); sets k = 1/d0^2 of eq. (13); '
+    danger_distance: float = param(0.25, 'd0 of eq. (20); sets k = 1/d0^2 of eq. (13); '
                                     'samples closer than d0 to an obstacle are discarded',
                                     'm', 0.05, 2.0)
-    repulsion_mode: str = _param('nearest', 'Repel from the nearest point only (eq. 7) or sum '
+    repulsion_mode: str = param('nearest', 'Repel from the nearest point only (eq. 7) or sum '
                                  'over all (voxel-downsampled) points (eq. 9-10)',
                                  choices=('nearest', 'sum'))
-    influence_distance: float = _param(1.0, 'Obstacle points farther than this exert no '
+    influence_distance: float = param(1.0, 'Obstacle points farther than this exert no '
                                        'repulsion', 'm', 0.1, 10.0)
     # --- APF step (eq. 23) -------------------------------------------------------------
-    step_gain: float = _param(0.05, 'eta: raw next move point = p + eta * F', 'm', 1e-4, 1.0)
-    max_step: float = _param(0.1, 'Longest raw step; also never past the goal', 'm',
+    step_gain: float = param(0.05, 'eta: raw next move point = p + eta * F', 'm', 1e-4, 1.0)
+    max_step: float = param(0.1, 'Longest raw step; also never past the goal', 'm',
                              0.005, 1.0)
     # --- circular sampling (Section IV, Algorithm 1, Fig. 5) ---------------------------
-    num_samples: int = _param(16, 'N points on the sampling circle', '', 3, 360)
-    sample_radius: float = _param(0.05, 'R, radius of the sampling circle', 'm', 0.001, 1.0)
-    priority_distance: float = _param(1.0, 'd threshold of Fig. 5: priority only when the '
+    num_samples: int = param(16, 'N points on the sampling circle', '', 3, 360)
+    sample_radius: float = param(0.05, 'R, radius of the sampling circle', 'm', 0.001, 1.0)
+    priority_distance: float = param(1.0, 'd threshold of Fig. 5: priority only when the '
                                       'nearest obstacle is closer than this', 'm', 0.0, 5.0)
-    priority_angle: float = _param(0.8, 'theta threshold of Fig. 5: priority only when goal '
+    priority_angle: float = param(0.8, 'theta threshold of Fig. 5: priority only when goal '
                                    'and nearest obstacle bearings differ by less', 'rad',
                                    0.0, math.pi)
-    priority_bonus: float = _param(0.25, 'Subtracted from the score of the priority sample',
+    priority_bonus: float = param(0.25, 'Subtracted from the score of the priority sample',
                                    'm', 0.0, 10.0)
     # --- scan conversion ---------------------------------------------------------------
-    voxel_size: float = _param(0.05, 'Grid cell for downsampling laser points (one point per '
+    voxel_size: float = param(0.05, 'Grid cell for downsampling laser points (one point per '
                                "cell), so a wall's push does not grow with beam density",
                                'm', 0.0, 1.0)
-    obstacle_range: float = _param(3.5, 'Laser returns beyond this are ignored', 'm',
+    obstacle_range: float = param(3.5, 'Laser returns beyond this are ignored', 'm',
                                    0.1, 100.0)
-    laser_x: float = _param(-0.032, 'Laser position in base_footprint (x)', 'm', -2.0, 2.0)
-    laser_y: float = _param(0.0, 'Laser position in base_footprint (y)', 'm', -2.0, 2.0)
-    laser_yaw: float = _param(0.0, 'Laser yaw in base_footprint', 'rad', -math.pi, math.pi)
+    laser_x: float = param(-0.032, 'Laser position in base_footprint (x)', 'm', -2.0, 2.0)
+    laser_y: float = param(0.0, 'Laser position in base_footprint (y)', 'm', -2.0, 2.0)
+    laser_yaw: float = param(0.0, 'Laser yaw in base_footprint', 'rad', -math.pi, math.pi)
     # --- command shaping (differential drive, TurtleBot3 burger limits) ---------------
-    planning_frequency: float = _param(5.0, 'Planning rate (paper: 5 Hz)', 'Hz', 0.5, 100.0)
-    max_linear_velocity: float = _param(0.22, 'Burger top speed', 'm/s', 0.0, 5.0)
-    max_angular_velocity: float = _param(2.84, 'Burger top turn rate', 'rad/s', 0.0, 10.0)
-    max_linear_acceleration: float = _param(1.0, 'Linear acceleration limit', 'm/s^2',
+    planning_frequency: float = param(5.0, 'Planning rate (paper: 5 Hz)', 'Hz', 0.5, 100.0)
+    max_linear_velocity: float = param(0.22, 'Burger top speed', 'm/s', 0.0, 5.0)
+    max_angular_velocity: float = param(2.84, 'Burger top turn rate', 'rad/s', 0.0, 10.0)
+    max_linear_acceleration: float = param(1.0, 'Linear acceleration limit', 'm/s^2',
                                             0.01, 20.0)
-    max_angular_acceleration: float = _param(3.2, 'Angular acceleration limit', 'rad/s^2',
+    max_angular_acceleration: float = param(3.2, 'Angular acceleration limit', 'rad/s^2',
                                              0.01, 50.0)
-    heading_gain: float = _param(2.5, 'w = heading_gain * heading error', '1/s', 0.0, 50.0)
-    rotate_in_place_angle: float = _param(0.9, 'Turn on the spot when the heading error '
+    heading_gain: float = param(2.5, 'w = heading_gain * heading error', '1/s', 0.0, 50.0)
+    rotate_in_place_angle: float = param(0.9, 'Turn on the spot when the heading error '
                                           'exceeds this', 'rad', 0.0, math.pi)
-    goal_tolerance: float = _param(0.15, 'xy goal tolerance; stop inside it', 'm', 0.01, 5.0)
-    slowdown_distance: float = _param(0.4, 'Speed scales down linearly inside this distance '
+    goal_tolerance: float = param(0.15, 'xy goal tolerance; stop inside it', 'm', 0.01, 5.0)
+    slowdown_distance: float = param(0.4, 'Speed scales down linearly inside this distance '
                                       'of the goal', 'm', 0.0, 10.0)
-    robot_radius: float = _param(0.105, 'Half-width of the forward safety corridor: forward '
+    robot_radius: float = param(0.105, 'Half-width of the forward safety corridor: forward '
                                  'speed is zeroed while an obstacle point lies inside it '
                                  'closer than danger_distance', 'm', 0.0, 2.0)
     # --- DWA baseline (Fox, Burgard, Thrun 1997) ---------------------------------------
-    dwa_horizon: float = _param(1.5, 'DWA rollout horizon', 's', 0.2, 10.0)
-    dwa_v_samples: int = _param(7, 'DWA linear velocity samples', '', 2, 50)
-    dwa_w_samples: int = _param(15, 'DWA angular velocity samples', '', 3, 101)
-    dwa_heading_weight: float = _param(0.8, 'DWA weight of the goal-heading term', '',
+    dwa_horizon: float = param(1.5, 'DWA rollout horizon', 's', 0.2, 10.0)
+    dwa_v_samples: int = param(7, 'DWA linear velocity samples', '', 2, 50)
+    dwa_w_samples: int = param(15, 'DWA angular velocity samples', '', 3, 101)
+    dwa_heading_weight: float = param(0.8, 'DWA weight of the goal-heading term', '',
                                        0.0, 100.0)
-    dwa_clearance_weight: float = _param(0.2, 'DWA weight of the clearance term', '',
+    dwa_clearance_weight: float = param(0.2, 'DWA weight of the clearance term', '',
                                          0.0, 100.0)
-    dwa_velocity_weight: float = _param(0.1, 'DWA weight of the forward-speed term', '',
+    dwa_velocity_weight: float = param(0.1, 'DWA weight of the forward-speed term', '',
                                         0.0, 100.0)
 
     def __post_init__(self) -> None:
-        for f in dataclasses.fields(self):
-            _check_field(f, getattr(self, f.name))
+        check_fields(self)
         if self.sample_radius >= self.danger_distance * 4:
             raise ConfigError('sample_radius: must be below 4 * danger_distance '
                               f'({self.sample_radius} >= {4 * self.danger_distance})')
@@ -126,27 +117,6 @@ class PlannerConfig:
         return from_mapping({**dataclasses.asdict(self), **changes})
 
 
-def _check_field(f: dataclasses.Field, value: Any) -> None:
-    meta = f.metadata
-    name = f.name
-    if f.type in ('float', float):
-        if isinstance(value, bool) or not isinstance(value, (int, float)):
-            raise ConfigError(f'{name}: expected a number, got {value!r}')
-        if not math.isfinite(value):
-            raise ConfigError(f'{name}: must be finite, got {value!r}')
-    elif f.type in ('int', int):
-        if isinstance(value, bool) or not isinstance(value, int):
-            raise ConfigError(f'{name}: expected an integer, got {value!r}')
-    elif f.type in ('str', str):
-        if not isinstance(value, str):
-            raise ConfigError(f'{name}: expected a string, got {value!r}')
-    if meta['choices'] is not None and value not in meta['choices']:
-        raise ConfigError(f'{name}: {value!r} is not one of {", ".join(meta["choices"])}')
-    lo, hi = meta['lo'], meta['hi']
-    if lo is not None and not lo <= value <= hi:
-        raise ConfigError(f'{name}: {value!r} is outside [{lo}, {hi}] {meta["unit"]}'.rstrip())
-
-
 def field_specs() -> list[dataclasses.Field]:
     """The dataclass fields, for building ROS parameter descriptors."""
     return list(dataclasses.fields(PlannerConfig))
@@ -154,18 +124,7 @@ def field_specs() -> list[dataclasses.Field]:
 
 def from_mapping(values: Mapping[str, Any], *, ignore_unknown: bool = False) -> PlannerConfig:
     """Build a config from a mapping; unknown keys are an error unless ignored."""
-    names = {f.name for f in dataclasses.fields(PlannerConfig)}
-    unknown = sorted(set(values) - names)
-    if unknown and not ignore_unknown:
-        raise ConfigError(f'unknown parameter(s): {", ".join(unknown)}')
-    kwargs = {}
-    for f in dataclasses.fields(PlannerConfig):
-        if f.name in values:
-            v = values[f.name]
-            if f.type in ('float', float) and isinstance(v, int) and not isinstance(v, bool):
-                v = float(v)
-            kwargs[f.name] = v
-    return PlannerConfig(**kwargs)
+    return build(PlannerConfig, values, ignore_unknown=ignore_unknown)
 
 
 def load_params_file(path: str | Path, node_name: str = 'subapf_planner') -> dict[str, Any]:

@@ -1,12 +1,13 @@
-"""The planner node's decisions, without ROS: input freshness, goal, progress, states.
+"""The decision loop, without ROS: input freshness, goal, progress, states.
 
-``planner_node`` feeds it messages as arrays with their times and publishes
-what ``tick`` decides; ``subapf-replay`` feeds it a recorded bag the same way,
-so a replay reproduces the node's commands. Times are seconds on the node's
-clock (simulated time under ``use_sim_time``).
+One loop for everything that plans: ``planner_node`` feeds it messages as
+arrays with their times and publishes what ``tick`` decides; ``subapf-replay``
+feeds it a recorded bag the same way; the benchmark's episode (sim/episode.py)
+feeds it the simulator's scans and odometry on simulated time. Times are
+seconds on the node's clock (simulated time under ``use_sim_time``).
 
-States (the text of ``~/status`` before the colon): idle, waiting, driving,
-reached, stopped, stuck.
+States (:class:`~.status.State`, the text of ``~/status`` before the colon):
+idle, waiting, driving, reached, stopped, stuck.
 """
 
 from __future__ import annotations
@@ -17,7 +18,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from .config import PlannerConfig
+from .params import check_fields, param
 from .planner import Planner, PlanResult
+from .status import State, Status
 
 #: Odometry poses kept to place each scan at the pose it was taken from.
 POSE_HISTORY = 100
@@ -25,19 +28,24 @@ POSE_HISTORY = 100
 POSE_MATCH = 0.1
 #: Goals closer than this to the current one are the same goal [m].
 SAME_GOAL = 1e-3
-#: Core statuses that stop the robot.
-STOP_STATUSES = ('no_safe_move', 'goal_in_obstacle', 'invalid_scan', 'invalid_pose',
-                 'invalid_goal')
 
 
 @dataclass(frozen=True)
 class Supervision:
-    """Node-level limits (config/planner.yaml, node section)."""
+    """Limits of the decision loop (config/planner.yaml, supervision section)."""
 
-    scan_timeout: float = 1.0
-    odom_timeout: float = 0.5
-    progress_distance: float = 0.5
-    progress_timeout: float = 10.0
+    scan_timeout: float = param(1.0, 'Stop when the newest scan is older than this', 's',
+                                0.05, 10.0)
+    odom_timeout: float = param(0.5, 'Stop when the newest odometry is older than this', 's',
+                                0.05, 10.0)
+    progress_distance: float = param(0.5, 'Progress checker: the robot must move this far '
+                                     'within progress_timeout, or the goal is abandoned '
+                                     '(state stuck)', 'm', 0.01, 10.0)
+    progress_timeout: float = param(10.0, 'Progress checker: time allowed for '
+                                    'progress_distance', 's', 1.0, 600.0)
+
+    def __post_init__(self) -> None:
+        check_fields(self)
 
 
 @dataclass(frozen=True)
@@ -54,11 +62,18 @@ class ScanInput:
 
 @dataclass(frozen=True)
 class Decision:
-    """What to publish: a command (None: publish nothing), the state, the plan if any."""
+    """What to publish: a command (None: publish nothing), the state and its reason,
+    the plan if any."""
 
     command: tuple[float, float] | None
-    state: str
+    state: State
+    reason: str
     result: PlanResult | None = None
+
+    @property
+    def text(self) -> str:
+        """``~/status`` on the wire: ``"state: reason"``."""
+        return f'{self.state}: {self.reason}'
 
 
 class PlannerController:
@@ -73,7 +88,8 @@ class PlannerController:
         self.odom_time: float | None = None
         self.poses: deque = deque(maxlen=POSE_HISTORY)
         self.goal: np.ndarray | None = None
-        self.state = 'idle: no goal'
+        self.state = State.IDLE
+        self.reason = 'no goal'
         self._progress: tuple[np.ndarray, float] | None = None
 
     @property
@@ -84,18 +100,23 @@ class PlannerController:
     def cfg(self, cfg: PlannerConfig) -> None:
         self.planner.cfg = cfg
 
+    @property
+    def text(self) -> str:
+        """The state as ``~/status`` carries it: ``"state: reason"``."""
+        return f'{self.state}: {self.reason}'
+
     def set_goal(self, goal: np.ndarray) -> bool:
         """A new goal resets the planner; the goal being driven to, sent again while
         driving, does not (a stuck or stopped robot retries it).
         Returns whether the goal was new."""
         goal = np.asarray(goal, float)
-        if self.goal is not None and self.state.startswith('driving') \
+        if self.goal is not None and self.state is State.DRIVING \
                 and np.hypot(*(goal - self.goal)) < SAME_GOAL:
             return False
         self.goal = goal.copy()
         self.planner.reset()
         self._progress = None
-        self.state = 'driving: new goal'
+        self._set(State.DRIVING, 'new goal')
         return True
 
     def clock_jumped(self) -> None:
@@ -106,7 +127,7 @@ class PlannerController:
         self.planner.reset()
         self._progress = None
         if self.goal is not None:
-            self.state = 'driving: clock jumped'
+            self._set(State.DRIVING, 'clock jumped')
 
     def update_scan(self, scan: ScanInput, now: float) -> None:
         self.scan, self.scan_time = scan, now
@@ -127,42 +148,45 @@ class PlannerController:
         t, pose = min(reversed(self.poses), key=lambda tp: abs(tp[0] - stamp))
         return pose if abs(t - stamp) <= POSE_MATCH else self.pose
 
-    def _stop(self, state: str) -> Decision:
+    def _set(self, state: State, reason: str) -> None:
+        self.state, self.reason = state, reason
+
+    def _decide(self, command: tuple[float, float] | None, state: State, reason: str,
+                result: PlanResult | None = None) -> Decision:
+        self._set(state, reason)
+        return Decision(command, state, reason, result)
+
+    def _stop(self, state: State, reason: str, result: PlanResult | None = None) -> Decision:
         self.planner.reset()
-        self.state = state
-        return Decision((0.0, 0.0), state)
+        return self._decide((0.0, 0.0), state, reason, result)
 
     def tick(self, now: float) -> Decision:
         """One planning period at time ``now`` [s]."""
         lim = self.limits
         if self.goal is None:
-            self.state = 'idle: no goal'
-            return Decision(None, self.state)
+            return self._decide(None, State.IDLE, 'no goal')
         if self.scan is None or self.pose is None:
-            self.state = f'waiting: no {"scan" if self.scan is None else "odom"} yet'
-            return Decision(None, self.state)
+            return self._decide(None, State.WAITING,
+                                f'no {"scan" if self.scan is None else "odom"} yet')
         if now - self.scan_time > lim.scan_timeout:
-            return self._stop('stopped: scan is stale')
+            return self._stop(State.STOPPED, 'scan is stale')
         if now - self.odom_time > lim.odom_timeout:
-            return self._stop('stopped: odometry is stale')
-        if self.state.startswith('stuck'):
-            return Decision((0.0, 0.0), self.state)
+            return self._stop(State.STOPPED, 'odometry is stale')
+        if self.state is State.STUCK:
+            return Decision((0.0, 0.0), self.state, self.reason)
         s = self.scan
         result = self.planner.step_scan(self.pose, self.goal, s.ranges, s.angle_min,
                                         s.angle_increment, s.range_min, s.range_max,
                                         self.pose_at(s.stamp))
         cmd = result.command
-        if cmd.status == 'reached':
+        if cmd.status is Status.REACHED:
             self.goal = None
-            decision = self._stop('reached: goal within tolerance')
-        elif cmd.status in STOP_STATUSES:
-            decision = self._stop(f'stopped: {cmd.status}')
-        elif self._no_progress(now):
-            decision = self._stop('stuck: no progress, goal abandoned')
-        else:
-            self.state = f'driving: {cmd.status}'
-            decision = Decision((cmd.v, cmd.w), self.state)
-        return Decision(decision.command, decision.state, result)
+            return self._stop(State.REACHED, 'goal within tolerance', result)
+        if cmd.status.stops:
+            return self._stop(State.STOPPED, cmd.status, result)
+        if self._no_progress(now):
+            return self._stop(State.STUCK, 'no progress, goal abandoned', result)
+        return self._decide((cmd.v, cmd.w), State.DRIVING, cmd.status, result)
 
     def _no_progress(self, now: float) -> bool:
         if self._progress is None or np.hypot(*(self.pose[:2] - self._progress[0])) >= \

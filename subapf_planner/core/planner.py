@@ -26,6 +26,7 @@ from .config import PlannerConfig
 from .dwa import dwa_command
 from .sampling import SamplingResult, clearance, sample_and_choose
 from .scan import ScanError, scan_to_points, voxel_downsample
+from .status import Status
 
 _EMPTY = np.zeros((0, 2))
 
@@ -58,16 +59,16 @@ def plan(cfg: PlannerConfig, pose: ArrayLike, goal: ArrayLike, obstacles: ArrayL
     pose = np.asarray(pose, float).ravel()
     goal = np.asarray(goal, float).ravel()
     if pose.shape != (3,) or not np.all(np.isfinite(pose)):
-        return PlanResult(Command(0.0, 0.0, 'invalid_pose'))
+        return PlanResult(Command(0.0, 0.0, Status.INVALID_POSE))
     if goal.shape != (2,) or not np.all(np.isfinite(goal)):
-        return PlanResult(Command(0.0, 0.0, 'invalid_goal'))
+        return PlanResult(Command(0.0, 0.0, Status.INVALID_GOAL))
     obs = _finite_points(obstacles)
     position = pose[:2]
     nearest = float(clearance(position, obs)[0])
     goal_distance = float(np.hypot(*(goal - position)))
     common = dict(obstacles=obs, nearest_distance=nearest, goal_distance=goal_distance)
     if goal_distance > cfg.goal_tolerance and float(clearance(goal, obs)[0]) < cfg.robot_radius:
-        return PlanResult(Command(0.0, 0.0, 'goal_in_obstacle'), **common)
+        return PlanResult(Command(0.0, 0.0, Status.GOAL_IN_OBSTACLE), **common)
     if cfg.method == 'dwa':
         return _plan_dwa(cfg, pose, goal, obs, previous, common)
     repulsors = voxel_downsample(obs, cfg.voxel_size)
@@ -84,13 +85,13 @@ def plan(cfg: PlannerConfig, pose: ArrayLike, goal: ArrayLike, obstacles: ArrayL
 def _plan_dwa(cfg: PlannerConfig, pose: NDArray, goal: NDArray, obs: NDArray,
               previous: tuple[float, float], common: dict) -> PlanResult:
     if common['goal_distance'] <= cfg.goal_tolerance:
-        return PlanResult(Command(0.0, 0.0, 'reached'), **common)
+        return PlanResult(Command(0.0, 0.0, Status.REACHED), **common)
     res = dwa_command(pose, goal, previous, voxel_downsample(obs, cfg.voxel_size), cfg)
     if not res.admissible:
-        return PlanResult(Command(0.0, 0.0, 'no_safe_move'), **common)
-    v, status = res.v, 'driving' if res.v > 0.0 else 'turning'
+        return PlanResult(Command(0.0, 0.0, Status.NO_SAFE_MOVE), **common)
+    v, status = res.v, Status.DRIVING if res.v > 0.0 else Status.TURNING
     if v > 0.0 and forward_blocked(pose, obs, cfg):
-        v, status = 0.0, 'blocked_ahead'
+        v, status = 0.0, Status.BLOCKED_AHEAD
     return PlanResult(Command(v, res.w, status), None, res.trajectory[-1].copy(), **common)
 
 
@@ -129,5 +130,5 @@ class Planner:
                                  cfg.obstacle_range)
         except ScanError:
             self.reset()
-            return PlanResult(Command(0.0, 0.0, 'invalid_scan'))
+            return PlanResult(Command(0.0, 0.0, Status.INVALID_SCAN))
         return self.step(pose, goal, pts)

@@ -13,17 +13,13 @@ planning is subapf_planner.core.planner.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 import sys
 
 from geometry_msgs.msg import PoseStamped, Twist, TwistStamped
 from nav_msgs.msg import Odometry
 import numpy as np
-from rcl_interfaces.msg import (
-    FloatingPointRange,
-    IntegerRange,
-    ParameterDescriptor,
-    SetParametersResult,
-)
+from rcl_interfaces.msg import SetParametersResult
 from rclpy.clock import JumpThreshold
 from rclpy.duration import Duration
 from rclpy.exceptions import ParameterException
@@ -33,8 +29,9 @@ from sensor_msgs.msg import LaserScan
 from std_msgs.msg import String
 from visualization_msgs.msg import MarkerArray
 
-from ..core.config import ConfigError, PlannerConfig, field_specs, from_mapping
+from ..core.config import ConfigError, PlannerConfig
 from ..core.controller import PlannerController, Supervision
+from ..core.params import check_fields, param
 from ..core.scan import geometry_warning
 from .conversions import (
     cmd_to_msg,
@@ -43,42 +40,38 @@ from .conversions import (
     scan_from_msg,
     stamp_to_seconds,
 )
+from .parameters import declare, read
 from .spinning import spin_node
 
 NODE_NAME = 'subapf_planner'
 #: A forward clock jump longer than this, or any backward one, resets the inputs [s].
 CLOCK_JUMP = 1.0
 
-#: Node-only parameters: name -> (default, description, lo, hi).
-NODE_PARAMS: dict[str, tuple] = {
-    'goal_from_parameters': (False, 'Drive to (goal_x, goal_y) at start instead of waiting '
-                             'for goal_pose', None, None),
-    'goal_x': (0.0, 'Goal x in odom_frame [m]', -1e6, 1e6),
-    'goal_y': (0.0, 'Goal y in odom_frame [m]', -1e6, 1e6),
-    'enable_stamped_cmd_vel': (True, 'Publish TwistStamped (true) or Twist (false)',
-                               None, None),
-    'publish_markers': (True, 'Publish ~/markers every cycle (costs about 1 ms of CPU)',
-                        None, None),
-    'laser_frame': ('base_scan', 'Expected scan frame_id; empty accepts any', None, None),
-    'odom_frame': ('odom', 'Frame of odometry and goals', None, None),
-    'scan_timeout': (1.0, 'Stop when the newest scan is older than this [s]', 0.05, 10.0),
-    'odom_timeout': (0.5, 'Stop when the newest odometry is older than this [s]', 0.05, 10.0),
-    'progress_distance': (0.5, 'Progress checker: required movement [m]', 0.01, 10.0),
-    'progress_timeout': (10.0, 'Progress checker: time allowed for it [s]', 1.0, 600.0),
-}
 
 
-def descriptor(description: str, lo: float | None, hi: float | None, integer: bool = False,
-               choices: tuple[str, ...] | None = None) -> ParameterDescriptor:
-    d = ParameterDescriptor(description=description)
-    if lo is not None and integer:
-        d.integer_range = [IntegerRange(from_value=int(lo), to_value=int(hi), step=1)]
-    elif lo is not None:
-        d.floating_point_range = [FloatingPointRange(from_value=float(lo), to_value=float(hi),
-                                                     step=0.0)]
-    if choices:
-        d.additional_constraints = 'one of: ' + ', '.join(choices)
-    return d
+@dataclass(frozen=True)
+class NodeOptions:
+    """The planner node's own parameters (the rest: PlannerConfig and Supervision)."""
+
+    goal_from_parameters: bool = param(False, 'Drive to (goal_x, goal_y) at start instead of '
+                                       'waiting for goal_pose', read_only=True)
+    goal_x: float = param(0.0, 'Goal x in odom_frame (with goal_from_parameters)', 'm',
+                          -1e6, 1e6, read_only=True)
+    goal_y: float = param(0.0, 'Goal y in odom_frame (with goal_from_parameters)', 'm',
+                          -1e6, 1e6, read_only=True)
+    enable_stamped_cmd_vel: bool = param(True, 'Publish TwistStamped (true) or Twist (false)',
+                                         read_only=True)
+    publish_markers: bool = param(True, 'Publish ~/markers every cycle (costs about 1 ms of '
+                                  'CPU)')
+    laser_frame: str = param('base_scan', 'Expected scan frame_id; empty accepts any')
+    odom_frame: str = param('odom', 'Frame of odometry and goals')
+
+    def __post_init__(self) -> None:
+        check_fields(self)
+
+
+#: The parameter groups of the node, in declaration order.
+GROUPS = (NodeOptions, Supervision, PlannerConfig)
 
 
 class PlannerNode(Node):
@@ -86,17 +79,15 @@ class PlannerNode(Node):
 
     def __init__(self, **kwargs) -> None:
         super().__init__(NODE_NAME, **kwargs)
-        for name, (default, text, lo, hi) in NODE_PARAMS.items():
-            self.declare_parameter(name, default, descriptor(text, lo, hi))
-        for f in field_specs():
-            m = f.metadata
-            text = m['description'] + (f' [{m["unit"]}]' if m['unit'] else '')
-            self.declare_parameter(f.name, f.default, descriptor(
-                text, m['lo'], m['hi'], f.type in ('int', int), m['choices']))
-        self.cfg = self._config_from({})      # raises ConfigError on a bad start value
-        self.add_on_set_parameters_callback(self._on_set_parameters)
+        declare(self, *GROUPS)
+        # a bad start value raises ConfigError naming it (exit code 2)
+        self.options = read(self, NodeOptions)
+        self.cfg = read(self, PlannerConfig)
+        self.ctl = PlannerController(self.cfg, read(self, Supervision))
+        self.add_on_set_parameters_callback(self._validate_parameters)
+        self.add_post_set_parameters_callback(self._apply_parameters)
 
-        stamped = self.get_parameter('enable_stamped_cmd_vel').value
+        stamped = self.options.enable_stamped_cmd_vel
         self.cmd_pub = self.create_publisher(TwistStamped if stamped else Twist, 'cmd_vel', 10)
         self.status_pub = self.create_publisher(String, '~/status', 10)
         self.marker_pub = self.create_publisher(MarkerArray, '~/markers', 10)
@@ -104,11 +95,9 @@ class PlannerNode(Node):
         self.create_subscription(Odometry, 'odom', self._on_odom, 10)
         self.create_subscription(PoseStamped, 'goal_pose', self._on_goal, 10)
 
-        self.ctl = PlannerController(self.cfg, self._supervision())
         self._last_state = ''
-        if self.get_parameter('goal_from_parameters').value:
-            self._set_goal(np.array([self.get_parameter('goal_x').value,
-                                     self.get_parameter('goal_y').value]))
+        if self.options.goal_from_parameters:
+            self._set_goal(np.array([self.options.goal_x, self.options.goal_y]))
         self.timer = self.create_timer(self.cfg.period, self._on_timer)
         self._jump_handle = self.get_clock().create_jump_callback(
             JumpThreshold(min_forward=Duration(seconds=CLOCK_JUMP),
@@ -121,33 +110,24 @@ class PlannerNode(Node):
             f'cmd_vel={"TwistStamped" if stamped else "Twist"}')
 
     # --- parameters -------------------------------------------------------------------
-    def _config_from(self, changes: dict) -> PlannerConfig:
-        values = {f.name: self.get_parameter(f.name).value for f in field_specs()}
-        values.update({k: v for k, v in changes.items() if k in values})
-        return from_mapping(values)
-
-    def _on_set_parameters(self, params: list) -> SetParametersResult:
+    def _validate_parameters(self, params: list) -> SetParametersResult:
+        """Refuse a change that makes any parameter group invalid (old values kept)."""
         changes = {p.name: p.value for p in params}
         try:
-            cfg = self._config_from(changes)
+            for group in GROUPS:
+                read(self, group, changes)
         except ConfigError as exc:
             return SetParametersResult(successful=False, reason=str(exc))
-        if 'enable_stamped_cmd_vel' in changes:
-            return SetParametersResult(successful=False,
-                                       reason='enable_stamped_cmd_vel is read at start only')
-        if cfg.planning_frequency != self.cfg.planning_frequency:
-            self.timer.timer_period_ns = int(cfg.period * 1e9)
-        self.cfg = cfg
-        if hasattr(self, 'ctl'):
-            self.ctl.cfg = cfg
-            self.ctl.limits = self._supervision(changes)
         return SetParametersResult(successful=True)
 
-    def _supervision(self, changes: dict | None = None) -> Supervision:
-        changes = changes or {}
-        return Supervision(**{f: changes.get(f, self.get_parameter(f).value)
-                              for f in ('scan_timeout', 'odom_timeout', 'progress_distance',
-                                        'progress_timeout')})
+    def _apply_parameters(self, params: list) -> None:
+        """Apply accepted changes: the core's configuration, the limits, the timer."""
+        cfg = read(self, PlannerConfig)
+        if cfg.planning_frequency != self.cfg.planning_frequency:
+            self.timer.timer_period_ns = int(cfg.period * 1e9)
+        self.options = read(self, NodeOptions)
+        self.cfg = self.ctl.cfg = cfg
+        self.ctl.limits = read(self, Supervision)
 
     def _on_clock_jump(self, jump) -> None:
         self.get_logger().warn(f'clock jumped by {jump.delta.nanoseconds * 1e-9:+.2f} s '
@@ -159,7 +139,7 @@ class PlannerNode(Node):
         return self.get_clock().now().nanoseconds * 1e-9
 
     def _on_scan(self, msg: LaserScan) -> None:
-        expected = self.get_parameter('laser_frame').value
+        expected = self.options.laser_frame
         if expected and msg.header.frame_id != expected:
             self.get_logger().warn(f'scan in frame "{msg.header.frame_id}", expected '
                                    f'"{expected}": dropped', throttle_duration_sec=5.0)
@@ -181,7 +161,7 @@ class PlannerNode(Node):
                                    throttle_duration_sec=5.0)
 
     def _on_goal(self, msg: PoseStamped) -> None:
-        frame = self.get_parameter('odom_frame').value
+        frame = self.options.odom_frame
         goal = np.array([msg.pose.position.x, msg.pose.position.y], dtype=float)
         if msg.header.frame_id not in ('', frame):
             self.get_logger().error(f'goal in frame "{msg.header.frame_id}" refused: give it '
@@ -202,14 +182,14 @@ class PlannerNode(Node):
         decision = self.ctl.tick(tick.nanoseconds * 1e-9)
         if decision.command is not None:   # the command first, stamped with the tick time
             self._publish_cmd(*decision.command, stamp=tick.to_msg())
-        if decision.result is not None and self.get_parameter('publish_markers').value:
+        if decision.result is not None and self.options.publish_markers:
             self.marker_pub.publish(markers_from_result(
-                decision.result, self.get_parameter('odom_frame').value, tick.to_msg(),
+                decision.result, self.options.odom_frame, tick.to_msg(),
                 self.cfg.danger_distance, self.ctl.pose, self.cfg.voxel_size))
-        if decision.state.startswith(('stopped', 'stuck')) and decision.state != self._last_state:
-            self.get_logger().warn(decision.state)
-        self._last_state = decision.state
-        self.status_pub.publish(String(data=decision.state))
+        if decision.state.halted and decision.text != self._last_state:
+            self.get_logger().warn(decision.text)
+        self._last_state = decision.text
+        self.status_pub.publish(String(data=decision.text))
 
     def _publish_cmd(self, v: float, w: float, stamp=None) -> None:
         stamped = self.cmd_pub.msg_type is TwistStamped

@@ -13,18 +13,21 @@ tf2_msgs is installed (not among the PyPI ROS wheels; odom carries the same pose
 
 from __future__ import annotations
 
-from collections import deque
+from dataclasses import dataclass
 import sys
 
 from geometry_msgs.msg import Twist, TwistStamped
 from nav_msgs.msg import Odometry
-import numpy as np
 from rclpy.node import Node
-from rclpy.qos import DurabilityPolicy, QoSProfile, qos_profile_sensor_data
+from rclpy.qos import qos_profile_sensor_data
 from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import LaserScan
 from std_msgs.msg import String
 
+from ..core.params import ConfigError, check_fields, param
+from ..core.status import Outcome
+from ..sim.faults import FAULT_SEED_OFFSET, ScanDelivery, ScanFaults
+from ..sim.outcome import outcome_of
 from ..sim.simulator import LASER_OFFSET, BurgerSim, SimConfig
 from ..sim.world import WorldError, load_world
 from .conversions import (
@@ -32,10 +35,10 @@ from .conversions import (
     odom_to_msg,
     scan_to_msg,
     seconds_to_stamp,
-    stamp_to_seconds,
     transform_msg,
 )
-from .planner_node import descriptor
+from .parameters import declare, read
+from .qos import LATCHED
 from .spinning import spin_node
 
 #: Simulated time per timer tick [s]; odometry and /clock go out every tick.
@@ -46,56 +49,56 @@ BASE_LINK_HEIGHT = 0.010
 LASER_IN_BASE_LINK = (LASER_OFFSET[0], LASER_OFFSET[1], LASER_OFFSET[2] - BASE_LINK_HEIGHT)
 #: Shortest wall-clock period of the stepping timer [s].
 MIN_TIMER_PERIOD = 0.005
-LATCHED = QoSProfile(depth=1, durability=DurabilityPolicy.TRANSIENT_LOCAL)
 
-PARAMS: dict[str, tuple] = {
-    'world': ('', 'World file (format v1 YAML)', None, None),
-    'rate': (1.0, 'Simulated seconds per wall-clock second', 0.1, 100.0),
-    'enable_stamped_cmd_vel': (True, 'Subscribe TwistStamped (true) or Twist', None, None),
-    'range_noise': (0.01, 'Laser range noise sigma [m]', 0.0, 1.0),
-    'beam_dropout': (0.0, 'Fraction of beams dropped (+inf)', 0.0, 1.0),
-    'scan_dropout': (0.0, 'Fraction of whole scans not published', 0.0, 1.0),
-    'scan_latency': (0.0, 'Scans are published this long after capture [s]', 0.0, 5.0),
-    'odom_noise': (0.0, 'Relative odometry drift per step', 0.0, 1.0),
-    'cmd_timeout': (0.5, 'Base watchdog: zero velocity after this without cmd_vel [s]',
-                    0.05, 10.0),
-    'seed': (0, 'Random seed of all noise', 0, 2**31 - 1),
-}
+
+
+@dataclass(frozen=True)
+class SimNodeOptions:
+    """The sim node's own parameters (the rest: SimConfig and ScanFaults)."""
+
+    world: str = param('', 'World file (format v1 YAML); required', read_only=True)
+    rate: float = param(1.0, 'Simulated seconds per wall-clock second', '', 0.1, 100.0,
+                        read_only=True)
+    enable_stamped_cmd_vel: bool = param(True, 'Subscribe TwistStamped (true) or Twist',
+                                         read_only=True)
+
+    def __post_init__(self) -> None:
+        check_fields(self)
+
+
+#: The parameter groups of the node, in declaration order.
+GROUPS = (SimNodeOptions, SimConfig, ScanFaults)
 
 
 class SimNode(Node):
     def __init__(self, **kwargs) -> None:
         super().__init__('subapf_sim', **kwargs)
-        for name, (default, text, lo, hi) in PARAMS.items():
-            self.declare_parameter(name, default, descriptor(text, lo, hi,
-                                                             isinstance(default, int)
-                                                             and not isinstance(default, bool)))
-        p = {name: self.get_parameter(name).value for name in PARAMS}
-        if not p['world']:
+        declare(self, *GROUPS)
+        options = read(self, SimNodeOptions)
+        if not options.world:
             raise WorldError('parameter "world" (a world file) is required')
-        self.world = load_world(p['world'])
-        self.sim = BurgerSim(self.world, SimConfig(
-            range_noise=p['range_noise'], beam_dropout=p['beam_dropout'],
-            odom_noise=p['odom_noise'], cmd_timeout=p['cmd_timeout'], seed=p['seed']))
-        self._rng = np.random.default_rng(p['seed'] + 1)
-        self.scan_dropout = p['scan_dropout']
-        self.scan_latency = p['scan_latency']
-        self._scans: deque = deque()
+        self.world = load_world(options.world)
+        sim_cfg = read(self, SimConfig)
+        self.sim = BurgerSim(self.world, sim_cfg)
+        self._scans: ScanDelivery[LaserScan] = ScanDelivery(read(self, ScanFaults),
+                                                            sim_cfg.seed + FAULT_SEED_OFFSET)
         self.clock_pub = self.create_publisher(Clock, '/clock', 10)
         self.scan_pub = self.create_publisher(LaserScan, 'scan', qos_profile_sensor_data)
         self.odom_pub = self.create_publisher(Odometry, 'odom', 10)
         self.truth_pub = self.create_publisher(Odometry, 'ground_truth', 10)
         self.outcome_pub = self.create_publisher(String, 'sim_outcome', LATCHED)
         self._setup_tf()
-        cmd_type = TwistStamped if p['enable_stamped_cmd_vel'] else Twist
+        cmd_type = TwistStamped if options.enable_stamped_cmd_vel else Twist
         self.create_subscription(cmd_type, 'cmd_vel', self._on_cmd, 10)
-        self.outcome: str | None = None
+        self.outcome: Outcome | None = None
         self._next_scan = 0.0
         # Fast mode: several ticks per timer callback, so the executor's overhead per
         # callback does not cap the speed-up.
-        self.ticks_per_call = max(1, int(round(MIN_TIMER_PERIOD * p['rate'] / TICK)))
-        self.timer = self.create_timer(self.ticks_per_call * TICK / p['rate'], self._on_timer)
-        self.get_logger().info(f'world {self.world.name} from {p["world"]}, rate {p["rate"]}x')
+        self.ticks_per_call = max(1, int(round(MIN_TIMER_PERIOD * options.rate / TICK)))
+        self.timer = self.create_timer(self.ticks_per_call * TICK / options.rate,
+                                       self._on_timer)
+        self.get_logger().info(f'world {self.world.name} from {options.world}, '
+                               f'rate {options.rate}x')
 
     def _setup_tf(self) -> None:
         """/tf (odom -> base_footprint) and /tf_static (base_footprint -> base_link ->
@@ -134,14 +137,12 @@ class SimNode(Node):
         self.truth_pub.publish(odom_to_msg(sim.true_pose(), twist, t, 'world'))
         if t + 1e-9 >= self._next_scan:
             self._next_scan += SCAN_PERIOD
-            if self._rng.random() >= self.scan_dropout:
-                s = sim.scan()
-                self._scans.append(scan_to_msg(s.ranges, s.angle_min, s.angle_increment,
-                                               s.range_min, s.range_max, t, 'base_scan'))
+            s = sim.scan()
+            self._scans.capture(scan_to_msg(s.ranges, s.angle_min, s.angle_increment,
+                                            s.range_min, s.range_max, t, 'base_scan'), t)
         # scans go out scan_latency after capture, stamped with their capture time
-        while self._scans and stamp_to_seconds(self._scans[0].header.stamp) \
-                + self.scan_latency <= t + 1e-9:
-            self.scan_pub.publish(self._scans.popleft())
+        for msg in self._scans.due(t):
+            self.scan_pub.publish(msg)
         # the clock last: a node on sim time then has this tick's data when its timers fire
         self.clock_pub.publish(Clock(clock=seconds_to_stamp(t)))
         if self.outcome is None:
@@ -153,21 +154,14 @@ class SimNode(Node):
 
     def _check_outcome(self) -> None:
         sim = self.sim
-        x, y, _ = sim.true_pose()
-        gx, gy = self.world.goal
-        if np.hypot(x - gx, y - gy) <= self.world.goal_tolerance:
-            self.outcome = 'reached'
-        elif sim.collided:
-            self.outcome = 'collision'
-        elif sim.time >= self.world.time_limit:
-            self.outcome = 'timeout'
+        self.outcome = outcome_of(self.world, sim.true_pose(), sim.collided, sim.time)
         if self.outcome is not None:
-            self.outcome_pub.publish(String(data=self.outcome))
+            self.outcome_pub.publish(String(data=str(self.outcome)))
             self.get_logger().info(f'outcome: {self.outcome} at t={sim.time:.1f} s')
 
 
 def main(args: list[str] | None = None) -> int:
-    return spin_node(SimNode, 'subapf-sim', (WorldError, ValueError), SimNode.close, args)
+    return spin_node(SimNode, 'subapf-sim', (WorldError, ConfigError), SimNode.close, args)
 
 
 if __name__ == '__main__':

@@ -19,7 +19,7 @@ from visualization_msgs.msg import MarkerArray
 from ..bag.writer import McapRecorder, type_name_of
 from .conversions import pose_from_odom, stamp_to_seconds
 from .processes import rss_mib
-from .sim_node import LATCHED
+from .qos import LATCHED
 from .spinning import stop_on_signals
 
 #: Depth of the recording subscriptions: deep enough that a busy recorder loses nothing.

@@ -1,26 +1,30 @@
-"""One benchmark run: simulator and planner in lockstep, in one process.
+"""One benchmark run: the simulator and the node's decision loop, in one process.
 
-At each planning period the planner gets the current scan and odometry,
-its command is applied, and the simulator advances one period of simulated
-time. No DDS and no wall-clock sleeping, so a run takes milliseconds per
-simulated second. The same loop underlies ``subapf-bench``.
+At each planning period the ``PlannerController`` (the loop ``planner_node``
+runs) gets the simulator's odometry and the scans that the fault model
+delivers, on simulated time: staleness stops, the progress checker and the
+goal states apply as in the node. Its command goes to the simulated base (no
+command while it waits: the base's watchdog stops the robot, as on a real
+burger); the simulator then advances one period. No DDS and no wall-clock
+sleeping, so a run takes milliseconds per simulated second. The loop under
+``subapf-bench``.
 """
 
 from __future__ import annotations
 
-from collections import deque
 from dataclasses import dataclass, field
-import math
 import time
 
 import numpy as np
 
 from ..core.config import PlannerConfig
-from ..core.planner import Planner
-from .simulator import BurgerSim, SimConfig
-from .world import FOOTPRINT_RADIUS, World
-
-OUTCOMES = ('reached', 'collision', 'timeout')
+from ..core.controller import PlannerController, ScanInput, Supervision
+from ..core.status import Outcome, State
+from .faults import FAULT_SEED_OFFSET, ScanDelivery, ScanFaults
+from .metrics import mean_abs_curvature, min_clearance, path_length
+from .outcome import outcome_of
+from .simulator import BurgerSim, Scan, SimConfig
+from .world import World
 
 
 @dataclass(frozen=True)
@@ -29,7 +33,7 @@ class EpisodeResult:
 
     world: str
     method: str
-    outcome: str
+    outcome: Outcome
     time_s: float
     path: np.ndarray
     plan_ms: np.ndarray
@@ -45,7 +49,7 @@ class EpisodeResult:
         return {
             'world': self.world,
             'method': self.method,
-            'outcome': self.outcome,
+            'outcome': str(self.outcome),
             'time_s': round(self.time_s, 3),
             'path_length': round(path_length(self.path), 4),
             'min_clearance': round(min_clearance(world, self.path), 4),
@@ -60,99 +64,51 @@ class EpisodeResult:
         }
 
 
-def path_length(path: np.ndarray) -> float:
-    """Length of the driven polyline [m]."""
-    if len(path) < 2:
-        return 0.0
-    return float(np.sum(np.hypot(*np.diff(path[:, :2], axis=0).T)))
-
-
-def min_clearance(world: World, path: np.ndarray) -> float:
-    """Smallest gap between the footprint (radius 0.105 m) and an obstacle surface [m]."""
-    if len(path) == 0:
-        return math.nan
-    return min(world.clearance(float(x), float(y)) for x, y in path[:, :2]) - FOOTPRINT_RADIUS
-
-
-def mean_abs_curvature(path: np.ndarray, min_segment: float = 0.01) -> float:
-    """Mean |turning angle| / segment length over the polyline [1/m] (smoothness).
-
-    Points closer than ``min_segment`` to the previous kept point are skipped,
-    so turning on the spot does not divide by zero.
-    """
-    pts = [path[0, :2]] if len(path) else []
-    for p in path[1:, :2]:
-        if np.hypot(*(p - pts[-1])) >= min_segment:
-            pts.append(p)
-    if len(pts) < 3:
-        return 0.0
-    seg = np.diff(np.asarray(pts), axis=0)
-    heading = np.arctan2(seg[:, 1], seg[:, 0])
-    turn = np.abs(np.remainder(np.diff(heading) + np.pi, 2 * np.pi) - np.pi)
-    lengths = np.hypot(seg[:, 0], seg[:, 1])
-    return float(np.mean(turn / (0.5 * (lengths[1:] + lengths[:-1]))))
-
-
-@dataclass(frozen=True)
-class Faults:
-    """Sensor faults between simulator and planner: a scan is lost with probability
-    ``scan_dropout`` (the planner keeps the last one it got) and reaches the planner
-    ``scan_delay`` planning periods after capture (placed with the pose at capture)."""
-
-    scan_dropout: float = 0.0
-    scan_delay: int = 0
-
-    def __post_init__(self) -> None:
-        if not 0.0 <= self.scan_dropout < 1.0:
-            raise ValueError(f'scan_dropout: {self.scan_dropout} is outside [0, 1)')
-        if not 0 <= self.scan_delay <= 50:
-            raise ValueError(f'scan_delay: {self.scan_delay} is outside [0, 50] periods')
+def scan_input(scan: Scan) -> ScanInput:
+    """The simulator's sweep as the decision loop takes it (stamp = capture time)."""
+    return ScanInput(scan.ranges, scan.angle_min, scan.angle_increment, scan.range_min,
+                     scan.range_max, scan.stamp)
 
 
 def run_episode(world: World, cfg: PlannerConfig, sim_cfg: SimConfig | None = None,
-                time_limit: float | None = None, faults: Faults | None = None) -> EpisodeResult:
-    """Drive the world's start to its goal with ``cfg.method``; stop at the first outcome."""
-    limit = world.time_limit if time_limit is None else time_limit
-    faults = faults or Faults()
-    rng = np.random.default_rng((sim_cfg.seed if sim_cfg else 0) + 7919)
-    in_flight: deque = deque()   # (scan, odom pose at capture) not yet delivered
-    delivered = None
-    goal = np.asarray(world.goal, float)
+                time_limit: float | None = None, faults: ScanFaults | None = None,
+                limits: Supervision | None = None, label: str | None = None) -> EpisodeResult:
+    """Drive the world's start to its goal; stop at the first outcome, or when the
+    planner abandons the goal (``Outcome.ABANDONED``). ``label`` names the method in
+    the result (default ``cfg.method``)."""
+    sim_cfg = sim_cfg or SimConfig()
+    delivery: ScanDelivery[Scan] = ScanDelivery(faults or ScanFaults(),
+                                                sim_cfg.seed + FAULT_SEED_OFFSET)
     cfg = cfg.replace(goal_tolerance=min(cfg.goal_tolerance, world.goal_tolerance))
-    planner = Planner(cfg)
+    ctl = PlannerController(cfg, limits)
+    ctl.set_goal(np.asarray(world.goal, float))
     path, plan_ms, statuses = [], [], {}
-    outcome = 'timeout'
     with BurgerSim(world, sim_cfg) as sim:
         while True:
             truth = sim.true_pose()
             path.append(truth)
-            if np.hypot(*(truth[:2] - goal)) <= world.goal_tolerance:
-                outcome = 'reached'
+            outcome = outcome_of(world, truth, sim.collided, sim.time, time_limit)
+            if outcome is None and ctl.state is State.STUCK:
+                outcome = Outcome.ABANDONED
+            if outcome is not None:
                 break
-            if sim.collided:
-                outcome = 'collision'
-                break
-            if sim.time >= limit - 1e-9:
-                break
+            now = sim.time
             odom, _ = sim.odometry()
-            if rng.random() >= faults.scan_dropout:
-                in_flight.append((sim.scan(), odom))
-            while in_flight and len(in_flight) > faults.scan_delay:
-                delivered = in_flight.popleft()
-            if delivered is None:   # nothing has arrived yet: wait, as the node does
-                sim.step(cfg.period)
-                continue
-            scan, scan_pose = delivered
+            ctl.update_odom(now, odom, now)
+            delivery.capture(sim.scan(), now)
+            for scan in delivery.due(now):
+                ctl.update_scan(scan_input(scan), now)
             t0 = time.perf_counter()
-            result = planner.step_scan(odom, goal, scan.ranges, scan.angle_min,
-                                       scan.angle_increment, scan.range_min, scan.range_max,
-                                       scan_pose)
-            plan_ms.append((time.perf_counter() - t0) * 1e3)
-            status = result.command.status
-            statuses[status] = statuses.get(status, 0) + 1
-            sim.set_command(result.command.v, result.command.w)
+            decision = ctl.tick(now)
+            if decision.result is not None:
+                plan_ms.append((time.perf_counter() - t0) * 1e3)
+            key = str(decision.result.command.status) if decision.result is not None \
+                else decision.text
+            statuses[key] = statuses.get(key, 0) + 1
+            if decision.command is not None:
+                sim.set_command(*decision.command)
             sim.step(cfg.period)
-        final = float(np.hypot(*(sim.true_pose()[:2] - goal)))
+        final = float(np.hypot(*(sim.true_pose()[:2] - np.asarray(world.goal, float))))
         elapsed = sim.time
-    return EpisodeResult(world.name, cfg.method, outcome, elapsed, np.asarray(path),
+    return EpisodeResult(world.name, label or cfg.method, outcome, elapsed, np.asarray(path),
                          np.asarray(plan_ms), final, statuses)

@@ -26,6 +26,7 @@ import numpy as np
 import pybullet
 from pybullet_utils.bullet_client import BulletClient
 
+from ..core.params import ConfigError, check_fields, param
 from .world import Box, Circle, World
 
 OBSTACLE_HEIGHT = 0.5
@@ -51,38 +52,34 @@ def _quiet_stdout() -> Iterator[None]:
 
 @dataclass(frozen=True)
 class SimConfig:
-    """Simulator settings (SI units). Defaults: the burger and its LDS-01."""
+    """Simulator settings (SI units). Defaults: the burger and its LDS-01 in Gazebo."""
 
-    physics_dt: float = 0.005
-    scan_beams: int = 360
-    range_min: float = 0.12
-    range_max: float = 3.5
-    range_noise: float = 0.0
-    beam_dropout: float = 0.0
-    odom_noise: float = 0.0
-    max_linear_velocity: float = 0.22
-    max_angular_velocity: float = 2.84
-    wheel_torque: float = 0.5
-    cmd_timeout: float = 0.5
-    seed: int = 0
+    physics_dt: float = param(0.005, 'Physics time step', 's', 1e-4, 0.05, read_only=True)
+    scan_beams: int = param(360, 'Lidar beams per sweep (LDS-01: 360)', '', 1, 4096,
+                            read_only=True)
+    range_min: float = param(0.12, 'Lidar minimum range', 'm', 0.0, 1.0, read_only=True)
+    range_max: float = param(3.5, 'Lidar maximum range', 'm', 0.1, 100.0, read_only=True)
+    range_noise: float = param(0.01, 'Lidar range noise sigma (Gazebo TurtleBot3: 0.01)', 'm',
+                               0.0, 1.0, read_only=True)
+    beam_dropout: float = param(0.0, 'Fraction of beams dropped (reported +inf)', '',
+                                0.0, 1.0, read_only=True)
+    odom_noise: float = param(0.0, 'Relative odometry drift per step', '', 0.0, 1.0,
+                              read_only=True)
+    max_linear_velocity: float = param(0.22, 'Base speed limit', 'm/s', 0.0, 5.0,
+                                       read_only=True)
+    max_angular_velocity: float = param(2.84, 'Base turn-rate limit', 'rad/s', 0.0, 20.0,
+                                        read_only=True)
+    wheel_torque: float = param(0.5, 'Wheel motor torque limit', 'N m', 1e-3, 100.0,
+                                read_only=True)
+    cmd_timeout: float = param(0.5, 'Base watchdog: zero velocity after this without a '
+                               'command', 's', 0.05, 10.0, read_only=True)
+    seed: int = param(0, 'Random seed of all noise', '', 0, 2**31 - 1, read_only=True)
 
     def __post_init__(self) -> None:
-        checks = {
-            'physics_dt': 0.0 < self.physics_dt <= 0.05,
-            'scan_beams': isinstance(self.scan_beams, int) and 1 <= self.scan_beams <= 4096,
-            'range_min': 0.0 <= self.range_min < self.range_max,
-            'range_max': 0.0 < self.range_max <= 100.0,
-            'range_noise': 0.0 <= self.range_noise <= 1.0,
-            'beam_dropout': 0.0 <= self.beam_dropout <= 1.0,
-            'odom_noise': 0.0 <= self.odom_noise <= 1.0,
-            'max_linear_velocity': self.max_linear_velocity >= 0.0,
-            'max_angular_velocity': self.max_angular_velocity >= 0.0,
-            'wheel_torque': self.wheel_torque > 0.0,
-            'cmd_timeout': self.cmd_timeout > 0.0,
-        }
-        for name, ok in checks.items():
-            if not ok:
-                raise ValueError(f'{name}: invalid value {getattr(self, name)!r}')
+        check_fields(self)
+        if self.range_min >= self.range_max:
+            raise ConfigError(f'range_min: {self.range_min} must be below range_max '
+                              f'{self.range_max}')
 
 
 @dataclass(frozen=True)

@@ -20,14 +20,15 @@ import numpy as np
 from tqdm import tqdm
 
 from ..core.config import METHODS, ConfigError, PlannerConfig, load_config
-from ..sim.episode import Faults, run_episode
+from ..sim.episode import run_episode
+from ..sim.faults import ScanFaults
 from ..sim.simulator import SimConfig
 from ..sim.world import WorldError, load_world, world_files
 from .paths import default_params_file, shipped_worlds_dir
 from .plots import plot_trajectories
 
 
-def _run(job: tuple[str, str, PlannerConfig, SimConfig, Faults]) -> tuple[dict, list]:
+def _run(job: tuple[str, str, PlannerConfig, SimConfig, ScanFaults]) -> tuple[dict, list]:
     path, method, cfg, sim_cfg, faults = job
     world = load_world(path)
     result = run_episode(world, cfg.replace(method=method), sim_cfg, faults=faults)
@@ -36,9 +37,9 @@ def _run(job: tuple[str, str, PlannerConfig, SimConfig, Faults]) -> tuple[dict, 
 
 def summarise(runs: list[dict], methods: list[str]) -> str:
     """Markdown table per method, then an outcome matrix method x world."""
-    lines = ['| method | runs | reached | collisions | timeouts | median time [s] '
+    lines = ['| method | runs | reached | collisions | timeouts | abandoned | median time [s] '
              '| median path [m] | min clearance [m] | median curvature [1/m] '
-             '| plan ms (median) |', '|' + '---|' * 10]
+             '| plan ms (median) |', '|' + '---|' * 11]
     for m in methods:
         rs = [r for r in runs if r['method'] == m]
         if not rs:
@@ -50,7 +51,8 @@ def summarise(runs: list[dict], methods: list[str]) -> str:
         lines.append(
             f'| {m} | {len(rs)} | {len(ok)}/{len(rs)} '
             f'| {sum(r["outcome"] == "collision" for r in rs)} '
-            f'| {sum(r["outcome"] == "timeout" for r in rs)} | {med("time_s")} '
+            f'| {sum(r["outcome"] == "timeout" for r in rs)} '
+            f'| {sum(r["outcome"] == "abandoned" for r in rs)} | {med("time_s")} '
             f'| {med("path_length")} | {min(r["min_clearance"] for r in rs):.3f} '
             f'| {med("mean_abs_curvature")} | {med("plan_ms_median", rs)} |')
     worlds = sorted({r['world'] for r in runs})
@@ -77,11 +79,11 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
     p.add_argument('--seed', type=int, default=0, help='simulator seed (noise)')
     p.add_argument('--noise', type=float, default=0.01,
                    help='laser range noise sigma [m] (Gazebo TurtleBot3: 0.01)')
-    p.add_argument('--dropout', type=float, default=0.0, help='fraction of dropped beams')
+    p.add_argument('--beam-dropout', type=float, default=0.0, help='fraction of dropped beams')
     p.add_argument('--scan-dropout', type=float, default=0.0,
                    help='probability that a scan never reaches the planner')
-    p.add_argument('--scan-delay', type=int, default=0,
-                   help='planning periods between a scan and its delivery')
+    p.add_argument('--scan-latency', type=float, default=0.0,
+                   help='seconds between a scan and its delivery to the planner')
     p.add_argument('--no-plots', action='store_true', help='skip the PNGs')
     return p.parse_args(argv)
 
@@ -96,8 +98,9 @@ def main(argv: list[str] | None = None) -> int:
         return 2
     try:
         cfg = load_config(args.params or default_params_file())
-        sim_cfg = SimConfig(seed=args.seed, range_noise=args.noise, beam_dropout=args.dropout)
-        faults = Faults(args.scan_dropout, args.scan_delay)
+        sim_cfg = SimConfig(seed=args.seed, range_noise=args.noise,
+                            beam_dropout=args.beam_dropout)
+        faults = ScanFaults(args.scan_dropout, args.scan_latency)
         files = world_files(args.worlds or [shipped_worlds_dir()])
         worlds = {str(f): load_world(f) for f in files}
     except (ConfigError, WorldError, ValueError) as exc:
@@ -116,8 +119,8 @@ def main(argv: list[str] | None = None) -> int:
     wall = time.perf_counter() - t0
     runs = [r for r, _ in results]
     doc = {'runs': runs, 'methods': methods, 'seed': args.seed, 'noise': args.noise,
-           'dropout': args.dropout, 'scan_dropout': args.scan_dropout,
-           'scan_delay': args.scan_delay, 'wall_time_s': round(wall, 2),
+           'beam_dropout': args.beam_dropout, 'scan_dropout': args.scan_dropout,
+           'scan_latency': args.scan_latency, 'wall_time_s': round(wall, 2),
            'params': {k: v for k, v in cfg.__dict__.items() if k != 'method'}}
     (out / 'results.json').write_text(json.dumps(doc, indent=1))
     (out / 'summary.md').write_text(summarise(runs, methods)

@@ -20,7 +20,7 @@ import numpy as np
 
 from ..core.config import METHODS, load_config
 from ..ros.processes import join_domain, start, stop
-from ..sim.episode import path_length
+from ..sim.metrics import path_length
 from ..sim.world import World, WorldError, load_world
 from .paths import default_params_file
 

@@ -1,0 +1,60 @@
+"""Typed states, statuses and outcomes; their string values are what goes on the wire.
+
+``~/status`` carries ``"<State>: <reason>"``; a reason is a :class:`Status`
+(``driving: turning``) or a supervision reason (``stopped: scan is stale``).
+"""
+
+from __future__ import annotations
+
+from enum import StrEnum
+
+
+class Status(StrEnum):
+    """What one planning cycle decided (core/planner.py, core/command.py)."""
+
+    DRIVING = 'driving'
+    TURNING = 'turning'
+    BLOCKED_AHEAD = 'blocked_ahead'
+    REACHED = 'reached'
+    NO_SAFE_MOVE = 'no_safe_move'
+    GOAL_IN_OBSTACLE = 'goal_in_obstacle'
+    GOAL_UNREACHABLE = 'goal_unreachable'
+    INVALID_SCAN = 'invalid_scan'
+    INVALID_POSE = 'invalid_pose'
+    INVALID_GOAL = 'invalid_goal'
+
+    @property
+    def stops(self) -> bool:
+        """The robot must stand still (a safety or input problem, not the goal)."""
+        return self in STOP_STATUSES
+
+
+STOP_STATUSES = frozenset({Status.NO_SAFE_MOVE, Status.GOAL_IN_OBSTACLE,
+                           Status.GOAL_UNREACHABLE, Status.INVALID_SCAN,
+                           Status.INVALID_POSE, Status.INVALID_GOAL})
+
+
+class State(StrEnum):
+    """The planner node's state (core/controller.py), the text before the colon."""
+
+    IDLE = 'idle'
+    WAITING = 'waiting'
+    DRIVING = 'driving'
+    REACHED = 'reached'
+    STOPPED = 'stopped'
+    STUCK = 'stuck'
+
+    @property
+    def halted(self) -> bool:
+        """The robot is held still by a stop (worth a warning)."""
+        return self in (State.STOPPED, State.STUCK)
+
+
+class Outcome(StrEnum):
+    """How a simulated run ended (sim/outcome.py)."""
+
+    REACHED = 'reached'
+    COLLISION = 'collision'
+    TIMEOUT = 'timeout'
+    #: The planner gave the goal up (progress checker) before the time limit.
+    ABANDONED = 'abandoned'
