@@ -10,6 +10,10 @@ from subapf_planner.sim.simulator import SimConfig
 from subapf_planner.sim.world import load_world
 from subapf_planner.tools.bench import main
 
+pytestmark = pytest.mark.sim
+
+#: The paper's method exactly: Euclidean attraction (eq. 21), samples discarded within d0.
+PAPER = PlannerConfig(attraction_field='euclidean')
 KEYS = {'world', 'method', 'outcome', 'time_s', 'path_length', 'min_clearance',
         'mean_abs_curvature', 'plan_ms_median', 'plan_ms_p99', 'cycles'}
 
@@ -51,7 +55,7 @@ def test_bench_rejects_unknown_method_and_bad_world(tmp_path, capsys):
 def test_only_sampling_passes_the_local_minima(worlds_dir, name):
     world = load_world(worlds_dir / f'{name}.yaml')
     quiet = SimConfig(range_noise=0.0)   # with noise, 6c's symmetric minimum breaks by luck
-    outcomes = {m: run_episode(world, PlannerConfig(method=m), quiet).outcome
+    outcomes = {m: run_episode(world, PAPER.replace(method=m), quiet).outcome
                 for m in ('subharmonic_sampling', 'subharmonic', 'traditional', 'harmonic')}
     assert outcomes['subharmonic_sampling'] == 'reached'
     assert all(outcomes[m] != 'reached' for m in ('subharmonic', 'traditional', 'harmonic'))
@@ -60,4 +64,4 @@ def test_only_sampling_passes_the_local_minima(worlds_dir, name):
 def test_full_method_passes_narrow_and_tight_worlds_without_collision(worlds_dir):
     for name in ('fig6a_narrow_obstacles', 'fig6b_tight_space', 'fig3_narrowing_passage'):
         world = load_world(worlds_dir / f'{name}.yaml')
-        assert run_episode(world, PlannerConfig()).outcome == 'reached', name
+        assert run_episode(world, PAPER).outcome == 'reached', name

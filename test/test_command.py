@@ -8,6 +8,8 @@ import pytest
 from subapf_planner.core.command import forward_blocked, shape_command
 from subapf_planner.core.config import PlannerConfig
 
+pytestmark = pytest.mark.core
+
 CFG = PlannerConfig()
 NONE = np.zeros((0, 2))
 

@@ -8,6 +8,8 @@ import yaml
 
 from subapf_planner.core.config import ConfigError, PlannerConfig, from_mapping, load_config
 
+pytestmark = pytest.mark.core
+
 
 def test_yaml_lists_every_core_parameter_with_its_default():
     params = yaml.safe_load(PARAMS.read_text())['subapf_planner']['ros__parameters']

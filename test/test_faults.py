@@ -19,6 +19,8 @@ from subapf_planner.sim.faults import ScanDelivery, ScanFaults
 from subapf_planner.sim.simulator import SimConfig
 from subapf_planner.sim.world import load_world, world_files
 
+pytestmark = [pytest.mark.sim, pytest.mark.node]
+
 FIG6 = ('fig6a_narrow_obstacles', 'fig6b_tight_space', 'fig6c_circle_in_front',
         'fig6d_big_wall')
 

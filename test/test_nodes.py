@@ -1,7 +1,6 @@
 """Planner node in one process: parameters, safety stops, cmd_vel type (rclpy executor)."""
 
 import math
-import os
 
 from geometry_msgs.msg import PoseStamped, Twist, TwistStamped
 from nav_msgs.msg import Odometry
@@ -17,8 +16,7 @@ from std_msgs.msg import String
 
 from subapf_planner.ros.conversions import odom_to_msg, scan_to_msg
 from subapf_planner.ros.planner_node import PlannerNode
-
-os.environ['ROS_DOMAIN_ID'] = str(60 + os.getpid() % 40)
+from subapf_planner.ros.qos import LATCHED as LATCHED_QOS
 
 
 @pytest.fixture
@@ -58,10 +56,10 @@ class Harness:
                 return True
         return False
 
-    def feed(self, pose=(0.0, 0.0, 0.0), scan=True, odom=True):
+    def feed(self, pose=(0.0, 0.0, 0.0), scan=True, odom=True, ranges=None):
         t = self.node.get_clock().now().nanoseconds * 1e-9
         if scan:
-            ranges = np.full(360, np.inf)
+            ranges = np.full(360, np.inf) if ranges is None else ranges
             self.scan_pub.publish(scan_to_msg(ranges, 0.0, math.pi / 180, 0.12, 3.5, t,
                                               'base_scan'))
         if odom:
@@ -175,3 +173,104 @@ def test_wrong_type_at_run_time_is_refused(harness):
     result = node.set_parameters([Parameter('danger_distance', value='wide')])[0]
     assert not result.successful
     assert node.get_parameter('danger_distance').value == 0.25
+
+
+SPIN_SCRIPT = """
+import sys
+from rclpy.node import Node
+from subapf_planner.ros.spinning import spin_node
+
+pytestmark = pytest.mark.node
+
+class Crashing(Node):
+    def __init__(self):
+        super().__init__('crashing')
+        self.create_timer(0.01, self.boom)
+
+    def boom(self):
+        raise ValueError('a bug in a callback')
+
+def stopped(node):
+    print('on_shutdown ran', flush=True)
+
+sys.exit(spin_node(Crashing, 'crashing', (ValueError,), stopped, []))
+"""
+
+
+def test_memory_and_plan_are_published_in_odom(harness):
+    from nav_msgs.msg import OccupancyGrid, Path
+    h = harness()
+    maps, plans = [], []
+    h.peer.create_subscription(OccupancyGrid, '/subapf_planner/map', maps.append, LATCHED_QOS)
+    h.peer.create_subscription(Path, '/subapf_planner/plan', plans.append, 10)
+    h.goal(3.0, 0.0)
+    ranges = np.full(360, np.inf)
+    ranges[350:] = ranges[:11] = 1.0              # a wall 1 m ahead, +-10 degrees
+    assert h.spin_until(lambda: (h.feed(ranges=ranges), bool(maps and plans))[1])
+    grid, plan = maps[-1], plans[-1]
+    assert grid.header.frame_id == plan.header.frame_id == 'odom'
+    assert grid.info.resolution == pytest.approx(0.05) and grid.info.width == 400
+    data = np.asarray(grid.data, np.int8).reshape(grid.info.height, grid.info.width)
+    col = int((1.0 - 0.032 - grid.info.origin.position.x) / grid.info.resolution)
+    row = int((0.0 - grid.info.origin.position.y) / grid.info.resolution)
+    assert data[row - 1:row + 2, col - 1:col + 2].max() > 50     # the wall
+    assert data[row, col - 10] < 50 and data[row, col - 10] != -1   # seen free
+    assert (data == -1).sum() > 0.5 * data.size                     # mostly never seen
+    xy = np.array([[p.pose.position.x, p.pose.position.y] for p in plan.poses])
+    assert len(xy) > 10 and np.hypot(*(xy[-1] - (3.0, 0.0))) < 0.1   # ends at the goal
+    assert np.abs(xy[:, 1]).max() > 0.15                               # round the wall
+
+
+def test_memory_topics_can_be_switched_off(harness):
+    from nav_msgs.msg import OccupancyGrid, Path
+    h = harness(publish_map=False, publish_plan=False)
+    got = []
+    h.peer.create_subscription(OccupancyGrid, '/subapf_planner/map', got.append, LATCHED_QOS)
+    h.peer.create_subscription(Path, '/subapf_planner/plan', got.append, 10)
+    h.goal(3.0, 0.0)
+    assert h.spin_until(lambda: (h.feed(), any(c.twist.linear.x > 0 for c in h.cmds))[1])
+    h.spin_until(lambda: bool(got), timeout=1.0)   # a few cycles after driving
+    assert got == [] and len(h.cmds) >= 3
+
+
+def test_spin_node_bad_input_only_while_building_bugs_keep_their_traceback():
+    """ros/spinning.py: a bad_input exception from the constructor is a clear message
+    and exit code 2; the same exception type raised while spinning is a bug: it
+    propagates with its traceback (non-zero exit), after on_shutdown and shutdown."""
+    import signal
+    import subprocess
+    import sys
+
+    from rclpy.node import Node
+
+    from subapf_planner.ros.spinning import spin_node
+
+    handlers = {s: signal.getsignal(s) for s in (signal.SIGINT, signal.SIGTERM)}
+    try:
+        def bad_parameter() -> Node:
+            raise ValueError('danger_distance: 5.0 is out of range')
+
+        shut = []
+        assert spin_node(bad_parameter, 'subapf-test', (ValueError,), shut.append, []) == 2
+        assert shut == [] and not rclpy.ok()
+
+        class Crashing(Node):
+            def __init__(self) -> None:
+                super().__init__('crashing')
+                self.create_timer(0.01, self.boom)
+
+            def boom(self) -> None:
+                raise ValueError('a bug in a callback')
+
+        with pytest.raises(ValueError, match='a bug in a callback'):
+            spin_node(Crashing, 'subapf-test', (ValueError,), lambda n: shut.append(n), [])
+        assert len(shut) == 1 and isinstance(shut[0], Crashing)   # zero velocity sent
+        assert not rclpy.ok()
+    finally:
+        for s, h in handlers.items():
+            signal.signal(s, h)
+    r = subprocess.run([sys.executable, '-c', SPIN_SCRIPT], capture_output=True, text=True,
+                       timeout=60)
+    assert r.returncode not in (0, 2), r.stderr
+    assert 'Traceback' in r.stderr and 'ValueError: a bug in a callback' in r.stderr
+    assert 'on_shutdown ran' in r.stdout

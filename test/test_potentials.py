@@ -1,4 +1,5 @@
-"""Potentials: analytic derivatives, Laplacian signs, the four-point example (NOTES.md 1-3)."""
+"""Potentials: analytic derivatives, Laplacian signs, the four-point example
+(docs/paper_notes.md sections 1-3)."""
 
 import math
 
@@ -16,6 +17,8 @@ from subapf_planner.core.potentials import (
     repulsive_laplacian,
     repulsive_value,
 )
+
+pytestmark = pytest.mark.core
 
 KINDS = ('traditional', 'harmonic', 'subharmonic')
 FOUR = np.array([[1.0, 1.0], [-1.0, -1.0], [-1.0, 1.0], [1.0, -1.0]])
@@ -81,7 +84,8 @@ def test_laplacian_matches_numeric(kind, r):
 
 
 def test_exponential_laplacian_sign_on_both_sides_of_d0():
-    """NOTES.md 2: lap(a exp(-k r^2)) < 0 inside d0 = 1/sqrt(k), >= 0 outside."""
+    """docs/paper_notes.md section 2: lap(a exp(-k r^2)) < 0 inside d0 = 1/sqrt(k),
+    >= 0 outside."""
     a, k = 1.0, 4.0
     d0 = 1 / math.sqrt(k)
     f = (lambda q: float(repulsive_value('subharmonic', np.hypot(*q), a, k)))
@@ -117,7 +121,8 @@ def test_four_points_harmonic_has_no_minimum_at_centre():
 
 
 def test_four_points_exponential_also_has_a_local_minimum():
-    """NOTES.md 3: 'subharmonic means no local minimum' is false: there is one at 0."""
+    """docs/paper_notes.md section 3: 'subharmonic means no local minimum' is false:
+    there is one at 0."""
     f = _four('subharmonic', k=4.0)
     eig = np.linalg.eigvalsh(hessian(f, [0, 0]))
     np.testing.assert_allclose(eig, [0.075, 0.075], atol=0.002)

@@ -1,7 +1,6 @@
 """Bad input: fuzzing the core and the node, and each kind of malformed message."""
 
 import math
-import os
 
 from geometry_msgs.msg import PoseStamped
 from hypothesis import HealthCheck, given, settings
@@ -20,6 +19,8 @@ from subapf_planner.core.controller import PlannerController, ScanInput
 from subapf_planner.core.planner import Planner, plan
 from subapf_planner.core.scan import geometry_warning
 from subapf_planner.ros.planner_node import PlannerNode
+
+pytestmark = pytest.mark.node
 
 CFG = PlannerConfig()
 weird = st.one_of(st.floats(-10, 10), st.sampled_from([math.nan, math.inf, -math.inf, 0.0]))
@@ -61,7 +62,6 @@ def test_fuzz_core_scans(ranges, angle_min, inc, rmin, rmax, pose):
 
 @pytest.fixture(scope='module')
 def node():
-    os.environ['ROS_DOMAIN_ID'] = str(20 + os.getpid() % 30)
     context = rclpy.Context()
     rclpy.init(context=context)
     n = PlannerNode(context=context, parameter_overrides=[Parameter('scan_timeout', value=10.0),
@@ -72,10 +72,14 @@ def node():
 
 
 class Captured:
+    """A fresh decision loop in the node (no state from earlier examples), with what the
+    node publishes and what the loop decided recorded."""
+
     def __init__(self, node):
         self.node, self.cmds, self.decisions = node, [], []
+        node.ctl = PlannerController(node.cfg, node.ctl.limits)
         node._publish_cmd = lambda v, w, stamp=None: self.cmds.append((v, w))
-        tick = PlannerController.tick.__get__(node.ctl)   # the unwrapped method
+        tick = node.ctl.tick
 
         def recording_tick(now):
             d = tick(now)
@@ -123,7 +127,7 @@ def test_fuzz_node(node, ranges, angle_min, inc, rmin, rmax, angle_max, frame, x
     cap = Captured(node)
     if goal is not None:
         node._on_goal(goal_msg(*goal))
-    elif node.ctl.goal is None:
+    if node.ctl.goal is None:
         node._on_goal(goal_msg(2.5, 1.0))
     node._on_scan(scan_msg(ranges, angle_min, inc, rmin, rmax, frame, angle_max))
     node._on_odom(odom_msg(x, y, q, cov))
@@ -139,7 +143,6 @@ def test_fuzz_node(node, ranges, angle_min, inc, rmin, rmax, angle_max, frame, x
 
 def drive(node, scan, pose=(0.0, 0.0), goal=(3.0, 0.0), q=(0, 0, 0, 1), stamp=0):
     cap = Captured(node)
-    node.ctl.goal = None
     node._on_goal(goal_msg(*goal))
     node._on_scan(scan)
     node._on_odom(odom_msg(*pose, q, stamp=stamp))
@@ -184,11 +187,14 @@ def test_all_inf_and_empty_scans_are_open_space(node):
         'driving')
 
 
-def test_obstacle_ahead_inside_danger_distance_zeroes_forward_speed(node):
+def test_obstacle_ahead_inside_the_safety_distance_zeroes_forward_speed(node):
     ranges = list(FREE)
-    ranges[0] = 0.2 + 0.032   # 0.2 m ahead of base_footprint
+    ranges[0] = 0.15 + 0.032   # 0.15 m ahead of base_footprint (safety_distance 0.18 m)
     d = drive(node, scan_msg(ranges, 0.0, math.pi / 180, 0.12, 3.5, 'base_scan'))
-    assert d.command is None or d.command[0] == 0.0
+    assert d.command is not None and d.command[0] == 0.0
+    ranges[0] = 0.6 + 0.032    # farther: the robot drives
+    d = drive(node, scan_msg(ranges, 0.0, math.pi / 180, 0.12, 3.5, 'base_scan'))
+    assert d.command is not None and d.command[0] > 0.0
 
 
 def test_nan_pose_dropped_and_quaternion_normalised(node):
@@ -235,10 +241,16 @@ def test_goal_equal_to_start_is_reached_at_once():
 
 
 def test_goal_behind_a_wall_without_progress_becomes_stuck():
-    ctl = PlannerController(CFG.replace(method='traditional'))
+    """The paper's traditional field in front of a wall it cannot pass: the robot (odometry
+    fixed, as if pushing) makes no progress, and the progress checker gives the goal up."""
+    ctl = PlannerController(CFG.replace(method='traditional', attraction_field='euclidean'))
     ctl.limits = type(ctl.limits)(progress_timeout=2.0)
     ctl.set_goal(np.array([0.0, 3.0]))
-    scan = ScanInput(np.full(360, np.inf), 0.0, math.pi / 180, 0.12, 3.5, 0.0)
+    ranges = np.full(360, np.inf)
+    a = np.radians(np.arange(360))
+    ahead = np.abs(np.remainder(a + np.pi, 2 * np.pi) - np.pi) < 1.2    # a wall 1 m ahead
+    ranges[ahead] = 1.0 / np.cos(a[ahead])
+    scan = ScanInput(ranges, 0.0, math.pi / 180, 0.12, 3.5, 0.0)
     states = []
     for k in range(20):   # the robot does not move (pose fixed): no progress
         ctl.update_scan(scan, 0.2 * k)

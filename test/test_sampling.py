@@ -17,7 +17,10 @@ from subapf_planner.core.sampling import (
     sample_and_choose,
 )
 
+pytestmark = pytest.mark.core
+
 CFG = PlannerConfig()
+PAPER = PlannerConfig(attraction_field='euclidean')
 coords = st.floats(-3.0, 3.0, allow_nan=False)
 obstacle_sets = arrays(np.float64, st.tuples(st.integers(0, 40), st.just(2)), elements=coords)
 
@@ -29,17 +32,20 @@ def test_samples_start_towards_goal_and_go_clockwise():
     np.testing.assert_allclose(np.hypot(*s.T), 1.0)
 
 
+@pytest.mark.parametrize('cfg', [CFG, PAPER], ids=['default', 'paper'])
 @given(obs=obstacle_sets, px=coords, py=coords, gx=coords, gy=coords)
 @settings(max_examples=300, deadline=None)
-def test_chosen_point_never_within_danger_distance(obs, px, py, gx, gy):
+def test_chosen_point_never_within_the_discard_distance(cfg, obs, px, py, gx, gy):
+    """Algorithm 1: d0 in the paper's method, sample_clearance with the geodesic field."""
+    assert cfg.discard_distance == (cfg.sample_clearance if cfg is CFG else cfg.danger_distance)
     pos = np.array([px, py])
-    raw = apf_step(pos, [gx, gy], obs, CFG)[0]
-    res = sample_and_choose(raw, pos, [gx, gy], obs, obs, CFG)
+    raw = apf_step(pos, [gx, gy], obs, cfg)[0]
+    res = sample_and_choose(raw, pos, [gx, gy], obs, obs, cfg)
     if res.chosen is not None:
-        assert clearance(res.chosen, obs)[0] > CFG.danger_distance
+        assert clearance(res.chosen, obs)[0] > cfg.discard_distance
     else:
-        assert np.all(clearance(res.samples, obs) <= CFG.danger_distance)
-    assert np.all(np.isinf(res.scores[res.clearance <= CFG.danger_distance]))
+        assert np.all(clearance(res.samples, obs) <= cfg.discard_distance)
+    assert np.all(np.isinf(res.scores[res.clearance <= cfg.discard_distance]))
 
 
 def test_all_samples_in_danger_gives_no_choice():

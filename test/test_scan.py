@@ -10,6 +10,8 @@ import pytest
 
 from subapf_planner.core.scan import ScanError, scan_to_points, valid_beams, voxel_downsample
 
+pytestmark = pytest.mark.core
+
 ranges_st = arrays(np.float64, st.integers(0, 500),
                    elements=st.one_of(st.floats(allow_nan=True, allow_infinity=True),
                                       st.floats(0.0, 5.0)))

@@ -8,6 +8,8 @@ import pytest
 from subapf_planner.sim.simulator import LASER_OFFSET, BurgerSim, SimConfig
 from subapf_planner.sim.world import parse_world
 
+pytestmark = pytest.mark.sim
+
 
 def world(obstacles=(), start=(0.0, 0.0, 0.0)):
     return parse_world({'name': 't', 'start': list(start), 'goal': [9.0, 9.0],

@@ -5,6 +5,8 @@ import yaml
 
 from subapf_planner.sim.world import Box, Circle, WorldError, load_world, world_files
 
+pytestmark = pytest.mark.sim
+
 GOOD = """
 name: wall_demo
 description: free text

@@ -37,7 +37,7 @@ def wrap_angle(a: float) -> float:
 
 def forward_blocked(pose: ArrayLike, obstacles: ArrayLike, cfg: PlannerConfig) -> bool:
     """True when an obstacle point lies ahead (x > 0 in the robot frame), within the
-    corridor |y| <= robot_radius and closer than danger_distance."""
+    corridor |y| <= robot_radius and closer than safety_distance to the centre."""
     obs = np.asarray(obstacles, float).reshape(-1, 2)
     if obs.shape[0] == 0:
         return False
@@ -47,7 +47,7 @@ def forward_blocked(pose: ArrayLike, obstacles: ArrayLike, cfg: PlannerConfig) -
     fx = c * dx + s * dy
     fy = -s * dx + c * dy
     hit = (fx > 0.0) & (np.abs(fy) <= cfg.robot_radius) & (np.hypot(fx, fy)
-                                                             < cfg.danger_distance)
+                                                             < cfg.safety_distance)
     return bool(np.any(hit))
 
 

@@ -82,10 +82,44 @@ class PlannerConfig:
     goal_tolerance: float = param(0.15, 'xy goal tolerance; stop inside it', 'm', 0.01, 5.0)
     slowdown_distance: float = param(0.4, 'Speed scales down linearly inside this distance '
                                       'of the goal', 'm', 0.0, 10.0)
-    robot_radius: float = param(0.105, 'Half-width of the forward safety corridor: forward '
-                                 'speed is zeroed while an obstacle point lies inside it '
-                                 'closer than danger_distance', 'm', 0.0, 2.0)
+    robot_radius: float = param(0.105, 'Robot radius: half-width of the forward safety '
+                                 'corridor; the field inflates obstacles by it', 'm', 0.0, 2.0)
+    safety_distance: float = param(0.18, 'Forward speed is zeroed while an obstacle point '
+                                    'lies in the corridor ahead closer than this to the centre '
+                                    '(0.075 m ahead of the footprint; stopping from 0.22 m/s '
+                                    'takes 0.024 m)', 'm', 0.0, 2.0)
+    # --- memory and navigation-function attraction (core/occupancy.py, navigation.py) --
+    attraction_field: str = param('geodesic', 'Attraction: geodesic (distance to the goal '
+                                  'through the occupancy memory, a navigation function with '
+                                  'no local minimum but the goal; the default) or euclidean '
+                                  "(the paper's eq. 21 exactly, samples discarded within "
+                                  'danger_distance)', choices=('geodesic', 'euclidean'))
+    sample_clearance: float = param(0.135, 'With the geodesic field: samples closer than this '
+                                    'to a laser point are discarded (the paper uses '
+                                    'danger_distance, which closes every gap narrower than '
+                                    '2 d0)', 'm', 0.0, 2.0)
+    field_gain: float = param(8.0, 'a_att of the geodesic attraction: a pull of this constant '
+                              'magnitude along the field (stronger than the Euclidean one, '
+                              "so eq. (13)'s repulsion bends the path but cannot turn it back "
+                              'in a passage narrower than 2 d0)', '', 0.0, 100.0)
+    map_size: float = param(20.0, 'Side of the square occupancy window that follows the '
+                            'robot (memory bound: (map_size/map_resolution)^2 * 4 bytes)',
+                            'm', 2.0, 200.0)
+    map_resolution: float = param(0.05, 'Occupancy cell size', 'm', 0.01, 0.5)
+    inflation_radius: float = param(0.105, 'Field: cells closer than this to an occupied cell '
+                                    'are in contact (travel there is 50 times slower; a goal '
+                                    'there is unreachable, and so is one that only gaps '
+                                    'narrower than twice this lead to)', 'm', 0.0, 2.0)
+    inflation_band: float = param(0.22, 'Field: beyond inflation_radius, travel speeds up '
+                                  'linearly to full over this band, so the field keeps to the '
+                                  'middle of passages', 'm', 0.0, 2.0)
+    field_period: float = param(1.0, 'Shortest time between two field computations (sooner '
+                                'for a new goal, or when the robot leaves the patch)', 's',
+                                0.0, 60.0)
     # --- DWA baseline (Fox, Burgard, Thrun 1997) ---------------------------------------
+    dwa_clearance: float = param(0.135, 'DWA: arcs passing closer than this to an obstacle '
+                                 'point are inadmissible (robot_radius + 0.03 m)', 'm',
+                                 0.0, 2.0)
     dwa_horizon: float = param(1.5, 'DWA rollout horizon', 's', 0.2, 10.0)
     dwa_v_samples: int = param(7, 'DWA linear velocity samples', '', 2, 50)
     dwa_w_samples: int = param(15, 'DWA angular velocity samples', '', 3, 101)
@@ -106,6 +140,16 @@ class PlannerConfig:
     def k(self) -> float:
         """k of eq. (13), from the danger distance by eq. (20): k = 1 / d0^2 [1/m^2]."""
         return 1.0 / self.danger_distance ** 2
+
+    @property
+    def geodesic(self) -> bool:
+        """The navigation-function attraction is on (never for DWA)."""
+        return self.attraction_field == 'geodesic' and self.method != 'dwa'
+
+    @property
+    def discard_distance(self) -> float:
+        """Samples closer than this to a laser point are discarded (Algorithm 1) [m]."""
+        return self.sample_clearance if self.geodesic else self.danger_distance
 
     @property
     def period(self) -> float:

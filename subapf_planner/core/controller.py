@@ -124,7 +124,7 @@ class PlannerController:
         every input and its time, keep the goal, and wait for fresh data."""
         self.scan = self.scan_time = self.pose = self.odom_time = None
         self.poses.clear()
-        self.planner.reset()
+        self.planner.forget()
         self._progress = None
         if self.goal is not None:
             self._set(State.DRIVING, 'clock jumped')
@@ -177,7 +177,7 @@ class PlannerController:
         s = self.scan
         result = self.planner.step_scan(self.pose, self.goal, s.ranges, s.angle_min,
                                         s.angle_increment, s.range_min, s.range_max,
-                                        self.pose_at(s.stamp))
+                                        self.pose_at(s.stamp), s.stamp, now)
         cmd = result.command
         if cmd.status is Status.REACHED:
             self.goal = None

@@ -3,7 +3,7 @@
 The classic local planner a TurtleBot3 user would otherwise pick. Velocity
 pairs (v, w) reachable within one planning period under the acceleration
 limits are rolled out as circular arcs over ``dwa_horizon`` seconds; an arc
-that passes closer than ``danger_distance`` to an obstacle point is not
+that passes closer than ``dwa_clearance`` to an obstacle point is not
 admissible (turning on the spot always is, since the footprint is round).
 Among the admissible arcs the one maximising
 
@@ -75,7 +75,7 @@ def dwa_command(pose: ArrayLike, goal: ArrayLike, previous: tuple[float, float],
     paths = rollout(pose, vs, ws, cfg.dwa_horizon)
     k, steps, _ = paths.shape
     clear = clearance(paths.reshape(-1, 2), obstacles).reshape(k, steps).min(axis=1)
-    admissible = (clear > cfg.danger_distance) | (vs <= 1e-9)
+    admissible = (clear > cfg.dwa_clearance) | (vs <= 1e-9)
     if not np.any(admissible):
         return DwaResult(0.0, 0.0, False, np.asarray(pose, float)[None, :2].copy())
     end = paths[:, -1, :]

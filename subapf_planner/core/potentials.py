@@ -1,6 +1,6 @@
 """Attractive and repulsive potentials with analytic derivatives (paper Section II).
 
-Signs follow ../shared/paper/NOTES.md section 1, not the paper's printed
+Signs follow docs/paper_notes.md section 1, not the paper's printed
 equations: every repulsive potential here is *high* near an obstacle, so that
 descending the total potential moves the robot away from obstacles.
 

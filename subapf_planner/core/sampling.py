@@ -36,9 +36,12 @@ from numpy.typing import ArrayLike, NDArray
 
 from .apf import apf_step
 from .config import PlannerConfig
+from .navigation import NavigationField
 
 #: A priority sample may be this fraction of R closer to the obstacles than the robot.
 PRIORITY_SLACK = 0.1
+#: Score added to the Euclidean distance where the navigation field has no value [m].
+UNKNOWN_PENALTY = 1000.0
 
 
 @dataclass(frozen=True)
@@ -79,20 +82,30 @@ def clearance(points: ArrayLike, obstacles: ArrayLike) -> NDArray[np.float64]:
 
 
 def evaluate_samples(samples: ArrayLike, goal: ArrayLike, obstacles: ArrayLike,
-                     repulsion_obstacles: ArrayLike,
-                     cfg: PlannerConfig) -> tuple[NDArray, NDArray]:
-    """Algorithm 1: (clearance, score) per sample; score inf inside the danger distance.
+                     repulsion_obstacles: ArrayLike, cfg: PlannerConfig,
+                     field: NavigationField | None = None) -> tuple[NDArray, NDArray]:
+    """Algorithm 1: (clearance, score) per sample; score inf (discarded) closer than
+    ``cfg.discard_distance`` to an obstacle point (the danger distance d0 in the paper's
+    method).
 
     ``obstacles`` are all valid points (used for the danger check);
-    ``repulsion_obstacles`` are the downsampled points the APF step uses.
+    ``repulsion_obstacles`` are the downsampled points the APF step uses. The score
+    is the distance to the goal of the next APF step [m]: Euclidean (the paper), or
+    through free space with a navigation ``field`` (where the field has no value,
+    inside an inflated obstacle, the Euclidean distance plus UNKNOWN_PENALTY).
     """
     s = np.atleast_2d(np.asarray(samples, float))
     clear = clearance(s, obstacles)
     scores = np.full(s.shape[0], np.inf)
-    safe = clear > cfg.danger_distance
+    safe = clear > cfg.discard_distance
     if np.any(safe):
-        nxt = apf_step(s[safe], goal, repulsion_obstacles, cfg)
-        scores[safe] = np.linalg.norm(nxt - np.asarray(goal, float), axis=1)
+        nxt = apf_step(s[safe], goal, repulsion_obstacles, cfg, field)
+        euclid = np.linalg.norm(nxt - np.asarray(goal, float), axis=1)
+        if field is None:
+            scores[safe] = euclid
+        else:
+            v = field.value(nxt)
+            scores[safe] = np.where(np.isfinite(v), v, euclid + UNKNOWN_PENALTY)
     return clear, scores
 
 
@@ -112,19 +125,38 @@ def priority_applies(position: ArrayLike, goal: ArrayLike, nearest: ArrayLike | 
     return theta < cfg.priority_angle
 
 
+def heading_target(point: ArrayLike, goal: ArrayLike,
+                   field: NavigationField | None) -> NDArray[np.float64]:
+    """Where "towards the goal" points from ``point``: the goal itself, or with a
+    navigation field one metre along its steepest descent (the way round obstacles)."""
+    p = np.asarray(point, float)
+    if field is not None:
+        d = field.direction(p)[0]
+        if np.any(d != 0.0):
+            return p + d
+    return np.asarray(goal, float)
+
+
 def sample_and_choose(raw_point: ArrayLike, position: ArrayLike, goal: ArrayLike,
                       obstacles: ArrayLike, repulsion_obstacles: ArrayLike,
-                      cfg: PlannerConfig) -> SamplingResult:
-    """Full circular sampling step: samples, Algorithm 1 scores, Fig. 5 priority, choice."""
-    samples = circle_samples(raw_point, goal, cfg.num_samples, cfg.sample_radius)
-    clear, scores = evaluate_samples(samples, goal, obstacles, repulsion_obstacles, cfg)
+                      cfg: PlannerConfig,
+                      field: NavigationField | None = None) -> SamplingResult:
+    """Full circular sampling step: samples, Algorithm 1 scores, Fig. 5 priority, choice.
+
+    With a navigation ``field`` the goal bearing of sample 0 and of the Fig. 5 test
+    is the field's descent direction, and scores are field values.
+    """
+    samples = circle_samples(raw_point, heading_target(raw_point, goal, field),
+                             cfg.num_samples, cfg.sample_radius)
+    clear, scores = evaluate_samples(samples, goal, obstacles, repulsion_obstacles, cfg,
+                                     field)
     obs = np.asarray(obstacles, float).reshape(-1, 2)
     prio = -1
     if obs.shape[0]:
         p = np.asarray(position, float)
         dist = np.hypot(*(obs - p).T)
         i_near = int(np.argmin(dist))
-        if priority_applies(p, goal, obs[i_near], cfg):
+        if priority_applies(p, heading_target(p, goal, field), obs[i_near], cfg):
             raw_clear = float(clearance(raw_point, obs)[0])
             keep = raw_clear - PRIORITY_SLACK * cfg.sample_radius
             ok = np.flatnonzero(np.isfinite(scores) & (clear >= keep))

@@ -5,16 +5,14 @@ from __future__ import annotations
 import math
 
 from builtin_interfaces.msg import Time
-from geometry_msgs.msg import Point, TransformStamped, Twist, TwistStamped
-from nav_msgs.msg import Odometry
+from geometry_msgs.msg import PoseStamped, TransformStamped, Twist, TwistStamped
+from nav_msgs.msg import OccupancyGrid as GridMsg
+from nav_msgs.msg import Odometry, Path
 import numpy as np
 from sensor_msgs.msg import LaserScan
-from std_msgs.msg import ColorRGBA
-from visualization_msgs.msg import Marker, MarkerArray
 
 from ..core.controller import ScanInput
-from ..core.planner import PlanResult
-from ..core.scan import voxel_downsample
+from ..core.occupancy import OccupancyGrid
 
 
 def stamp_to_seconds(stamp: Time) -> float:
@@ -116,57 +114,36 @@ def cmd_from_msg(msg: Twist | TwistStamped) -> tuple[float, float]:
     return float(twist.linear.x), float(twist.angular.z)
 
 
-def _marker(ns: str, mid: int, mtype: int, frame: str, stamp: Time, scale: float,
-            rgba: tuple[float, float, float, float]) -> Marker:
-    m = Marker()
-    m.header.frame_id = frame
-    m.header.stamp = stamp
-    m.ns, m.id, m.type, m.action = ns, mid, mtype, Marker.ADD
-    m.pose.orientation.w = 1.0
-    m.scale.x = m.scale.y = m.scale.z = scale
-    m.color = ColorRGBA(r=rgba[0], g=rgba[1], b=rgba[2], a=rgba[3])
-    return m
+def grid_to_msg(grid: OccupancyGrid, frame: str, stamp: Time) -> GridMsg:
+    """The occupancy memory as nav_msgs/OccupancyGrid: occupancy probability 0-100 from
+    the log odds, -1 where nothing was ever seen; row-major from cell (0, 0)."""
+    msg = GridMsg()
+    msg.header.frame_id = frame
+    msg.header.stamp = stamp
+    msg.info.map_load_time = stamp
+    msg.info.resolution = float(grid.resolution)
+    msg.info.width = msg.info.height = int(grid.cells)
+    msg.info.origin.position.x, msg.info.origin.position.y = (float(v) for v in grid.origin)
+    msg.info.origin.orientation.w = 1.0
+    lo = grid.log_odds.astype(np.float64)
+    data = np.rint(100.0 / (1.0 + np.exp(-lo))).astype(np.int8)
+    data[lo == 0.0] = -1
+    msg.data = data.ravel().tolist()
+    return msg
 
 
-def _points(xy: np.ndarray) -> list[Point]:
-    return [Point(x=float(x), y=float(y), z=0.0) for x, y in np.asarray(xy).reshape(-1, 2)]
-
-
-def markers_from_result(result: PlanResult, frame: str, stamp: Time,
-                        danger_distance: float, position: np.ndarray,
-                        voxel: float = 0.05) -> MarkerArray:
-    """Obstacle points (voxel-downsampled, as the repulsion sees them), raw next move
-    point, samples coloured by score, chosen point and the danger circle around the
-    robot, for RViz or Foxglove."""
-    out = MarkerArray()
-    obs = _marker('obstacles', 0, Marker.POINTS, frame, stamp, 0.03, (0.9, 0.2, 0.2, 1.0))
-    obs.points = _points(voxel_downsample(result.obstacles, voxel))
-    out.markers.append(obs)
-    for ns, point, rgba in (('raw_point', result.raw_point, (1.0, 0.6, 0.0, 1.0)),
-                            ('chosen_point', result.chosen_point, (0.0, 0.8, 0.0, 1.0))):
-        m = _marker(ns, 0, Marker.SPHERE, frame, stamp, 0.04, rgba)
-        if point is None:
-            m.action = Marker.DELETE
-        else:
-            m.pose.position.x, m.pose.position.y = float(point[0]), float(point[1])
-        out.markers.append(m)
-    samples = _marker('samples', 0, Marker.POINTS, frame, stamp, 0.02, (0.2, 0.2, 1.0, 1.0))
-    if result.sampling is not None:
-        samples.points = _points(result.sampling.samples)
-        scores = result.sampling.scores
-        finite = scores[np.isfinite(scores)]
-        lo, hi = (finite.min(), finite.max()) if finite.size else (0.0, 1.0)
-        for s in scores:
-            if not np.isfinite(s):
-                samples.colors.append(ColorRGBA(r=0.3, g=0.3, b=0.3, a=0.6))
-            else:
-                t = float((s - lo) / (hi - lo)) if hi > lo else 0.0
-                samples.colors.append(ColorRGBA(r=t, g=1.0 - t, b=0.2, a=1.0))
-    out.markers.append(samples)
-    ring = _marker('danger_circle', 0, Marker.LINE_STRIP, frame, stamp, 0.01,
-                   (1.0, 0.0, 0.0, 0.5))
-    a = np.linspace(0.0, 2.0 * math.pi, 37)
-    ring.points = _points(np.column_stack((position[0] + danger_distance * np.cos(a),
-                                           position[1] + danger_distance * np.sin(a))))
-    out.markers.append(ring)
-    return out
+def path_to_msg(points: np.ndarray, frame: str, stamp: Time) -> Path:
+    """A polyline (k, 2) [m] as nav_msgs/Path (orientations along the path)."""
+    msg = Path()
+    msg.header.frame_id = frame
+    msg.header.stamp = stamp
+    pts = np.asarray(points, float).reshape(-1, 2)
+    heading = np.arctan2(*np.diff(pts, axis=0, append=pts[-1:]).T[::-1]) if len(pts) else []
+    for (x, y), yaw in zip(pts, heading, strict=True):
+        pose = PoseStamped()
+        pose.header = msg.header
+        pose.pose.position.x, pose.pose.position.y = float(x), float(y)
+        pose.pose.orientation.z = math.sin(0.5 * yaw)
+        pose.pose.orientation.w = math.cos(0.5 * yaw)
+        msg.poses.append(pose)
+    return msg

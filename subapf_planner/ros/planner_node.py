@@ -5,10 +5,12 @@ Topics (relative, so namespaces and remapping work):
        goal_pose (geometry_msgs/PoseStamped, in the odom frame)
   out: cmd_vel (geometry_msgs/TwistStamped, or Twist with
        enable_stamped_cmd_vel:=false), ~/status (std_msgs/String,
-       "state: reason"), ~/markers (visualization_msgs/MarkerArray)
+       "state: reason"), ~/markers (visualization_msgs/MarkerArray),
+       ~/map (nav_msgs/OccupancyGrid, transient local, the occupancy memory),
+       ~/plan (nav_msgs/Path, the navigation field's steepest descent)
 
 The node only translates messages and parameters and drives one timer; the
-planning is subapf_planner.core.planner.
+decisions are subapf_planner.core.controller's.
 """
 
 from __future__ import annotations
@@ -17,7 +19,8 @@ from dataclasses import dataclass
 import sys
 
 from geometry_msgs.msg import PoseStamped, Twist, TwistStamped
-from nav_msgs.msg import Odometry
+from nav_msgs.msg import OccupancyGrid as GridMsg
+from nav_msgs.msg import Odometry, Path
 import numpy as np
 from rcl_interfaces.msg import SetParametersResult
 from rclpy.clock import JumpThreshold
@@ -35,12 +38,15 @@ from ..core.params import check_fields, param
 from ..core.scan import geometry_warning
 from .conversions import (
     cmd_to_msg,
-    markers_from_result,
+    grid_to_msg,
+    path_to_msg,
     pose_from_odom,
     scan_from_msg,
     stamp_to_seconds,
 )
+from .markers import markers_from_result
 from .parameters import declare, read
+from .qos import LATCHED
 from .spinning import spin_node
 
 NODE_NAME = 'subapf_planner'
@@ -63,6 +69,11 @@ class NodeOptions:
                                          read_only=True)
     publish_markers: bool = param(True, 'Publish ~/markers every cycle (costs about 1 ms of '
                                   'CPU)')
+    publish_map: bool = param(True, 'Publish the occupancy memory on ~/map '
+                              '(nav_msgs/OccupancyGrid, transient local) at map_rate')
+    map_rate: float = param(1.0, 'Rate of ~/map', 'Hz', 0.1, 5.0)
+    publish_plan: bool = param(True, "Publish the field's steepest-descent path from the "
+                               'robot on ~/plan (nav_msgs/Path) every cycle')
     laser_frame: str = param('base_scan', 'Expected scan frame_id; empty accepts any')
     odom_frame: str = param('odom', 'Frame of odometry and goals')
 
@@ -91,6 +102,9 @@ class PlannerNode(Node):
         self.cmd_pub = self.create_publisher(TwistStamped if stamped else Twist, 'cmd_vel', 10)
         self.status_pub = self.create_publisher(String, '~/status', 10)
         self.marker_pub = self.create_publisher(MarkerArray, '~/markers', 10)
+        self.map_pub = self.create_publisher(GridMsg, '~/map', LATCHED)
+        self.plan_pub = self.create_publisher(Path, '~/plan', 10)
+        self._map_time: float | None = None
         self.create_subscription(LaserScan, 'scan', self._on_scan, qos_profile_sensor_data)
         self.create_subscription(Odometry, 'odom', self._on_odom, 10)
         self.create_subscription(PoseStamped, 'goal_pose', self._on_goal, 10)
@@ -186,10 +200,26 @@ class PlannerNode(Node):
             self.marker_pub.publish(markers_from_result(
                 decision.result, self.options.odom_frame, tick.to_msg(),
                 self.cfg.danger_distance, self.ctl.pose, self.cfg.voxel_size))
+        self._publish_memory(decision, tick)
         if decision.state.halted and decision.text != self._last_state:
             self.get_logger().warn(decision.text)
         self._last_state = decision.text
         self.status_pub.publish(String(data=decision.text))
+
+    def _publish_memory(self, decision, tick) -> None:
+        """~/plan every cycle the field was used; ~/map at most at map_rate."""
+        if not self.cfg.geodesic:
+            return
+        frame, now = self.options.odom_frame, tick.nanoseconds * 1e-9
+        field = decision.result.field if decision.result is not None else None
+        if self.options.publish_plan and field is not None and self.ctl.pose is not None:
+            self.plan_pub.publish(path_to_msg(field.path(self.ctl.pose[:2]), frame,
+                                              tick.to_msg()))
+        if self.options.publish_map and (self._map_time is None or now < self._map_time
+                                         or now - self._map_time >= 1.0 / self.options.map_rate):
+            self._map_time = now
+            self.map_pub.publish(grid_to_msg(self.ctl.planner.memory.grid, frame,
+                                             tick.to_msg()))
 
     def _publish_cmd(self, v: float, w: float, stamp=None) -> None:
         stamped = self.cmd_pub.msg_type is TwistStamped

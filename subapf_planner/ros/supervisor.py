@@ -6,10 +6,10 @@ import subprocess
 import time
 
 from geometry_msgs.msg import PoseStamped, TwistStamped
-from nav_msgs.msg import Odometry
+from nav_msgs.msg import OccupancyGrid, Odometry, Path
 import rclpy
 from rclpy.node import Node
-from rclpy.qos import QoSProfile, ReliabilityPolicy
+from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from rclpy.signals import SignalHandlerOptions
 from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import LaserScan
@@ -26,6 +26,7 @@ from .spinning import stop_on_signals
 RECORD_DEPTH = 500
 _SENSOR = QoSProfile(depth=RECORD_DEPTH, reliability=ReliabilityPolicy.BEST_EFFORT)
 _RELIABLE = QoSProfile(depth=RECORD_DEPTH)
+_LATCHED_DEEP = QoSProfile(depth=RECORD_DEPTH, durability=DurabilityPolicy.TRANSIENT_LOCAL)
 #: topic -> (type, QoS) recorded by --record (absolute names of the bringup graph).
 RECORDED = {
     '/scan': (LaserScan, _SENSOR),
@@ -37,7 +38,11 @@ RECORDED = {
     '/sim_outcome': (String, LATCHED),
     '/subapf_planner/status': (String, _RELIABLE),
     '/subapf_planner/markers': (MarkerArray, _RELIABLE),
+    '/subapf_planner/plan': (Path, _RELIABLE),
+    '/subapf_planner/map': (OccupancyGrid, _LATCHED_DEEP),
 }
+#: Recorded only when asked for by name (--record-topics): the map is 160 kB a message.
+ON_REQUEST = {'/subapf_planner/map'}
 
 
 class Supervisor:
@@ -63,7 +68,7 @@ class Supervisor:
         self.node.create_subscription(String, '/subapf_planner/status', self._on_status, 10)
         if self.recorder is not None:
             for topic, (msg_type, qos) in RECORDED.items():
-                if record_topics and topic not in record_topics:
+                if topic not in (record_topics or set(RECORDED) - ON_REQUEST):
                     continue
                 self.recorder.add_topic(topic, type_name_of(msg_type))
                 self.node.create_subscription(msg_type, topic, self._recording(topic), qos,

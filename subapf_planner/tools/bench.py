@@ -1,15 +1,19 @@
-"""``subapf-bench``: the paper's ablation (Fig. 6) and the DWA baseline on many worlds.
+"""``subapf-bench``: the package's default, the paper's ablation (Fig. 6) and the DWA
+baseline on many worlds, side by side.
 
-Every (world, method) run steps the simulator and the planner in lockstep in
-one process (episode.py); ``--jobs`` spreads runs over processes. Writes
-``results.json``, ``summary.md`` and one Fig. 6-style PNG per world to --out.
-One parameter file (default: the package's config/planner.yaml) for all worlds.
+Every (world, method) run steps the simulator and the node's decision loop in
+lockstep in one process (sim/episode.py); ``--jobs`` spreads the worlds over
+processes, each drawing its world's Fig. 6-style PNG. Writes ``results.json``,
+``summary.md`` and the PNGs to --out. One parameter file (default: the
+package's config/planner.yaml) for all worlds; a method may name its attraction
+field (``subharmonic_sampling:euclidean`` is the paper's method exactly).
 """
 
 from __future__ import annotations
 
 import argparse
 from concurrent.futures import ProcessPoolExecutor
+import dataclasses
 import json
 from pathlib import Path
 import statistics
@@ -19,7 +23,7 @@ import time
 import numpy as np
 from tqdm import tqdm
 
-from ..core.config import METHODS, ConfigError, PlannerConfig, load_config
+from ..core.config import METHODS, ConfigError, load_config
 from ..sim.episode import run_episode
 from ..sim.faults import ScanFaults
 from ..sim.simulator import SimConfig
@@ -27,12 +31,66 @@ from ..sim.world import WorldError, load_world, world_files
 from .paths import default_params_file, shipped_worlds_dir
 from .plots import plot_trajectories
 
+#: The default comparison: the package's default, the paper's method and its ablations
+#: (Euclidean attraction, eq. 21), and the DWA baseline.
+DEFAULT_METHODS = ('subharmonic_sampling:geodesic', 'subharmonic_sampling:euclidean',
+                   'subharmonic:euclidean', 'traditional:euclidean', 'harmonic:euclidean',
+                   'dwa')
+FIELDS = ('geodesic', 'euclidean')
 
-def _run(job: tuple[str, str, PlannerConfig, SimConfig, ScanFaults]) -> tuple[dict, list]:
-    path, method, cfg, sim_cfg, faults = job
+
+def parse_method(spec: str) -> dict:
+    """``method[:attraction_field]`` -> config changes; ValueError when unknown. Without a
+    field the configuration's attraction_field applies."""
+    name, _, field = spec.strip().partition(':')
+    if name not in METHODS or (field and field not in FIELDS) or (name == 'dwa' and field):
+        raise ValueError(f'unknown method {spec!r}: use one of {", ".join(METHODS)}, APF '
+                         f'ones optionally with :{"/:".join(FIELDS)}')
+    changes = {'method': name}
+    if field:
+        changes['attraction_field'] = field
+    return changes
+
+
+def _run_world(job: tuple) -> list[tuple[dict, list]]:
+    """All methods on one world (in a worker), and its plot when ``plot_dir`` is set."""
+    path, methods, cfg, sim_cfg, faults, plot_dir = job
     world = load_world(path)
-    result = run_episode(world, cfg.replace(method=method), sim_cfg, faults=faults)
-    return result.metrics(world), result.path[:, :2].round(4).tolist()
+    out = []
+    for spec in methods:
+        run_cfg = cfg.replace(**parse_method(spec))
+        label = 'dwa' if run_cfg.method == 'dwa' else \
+            f'{run_cfg.method}:{run_cfg.attraction_field}'
+        result = run_episode(world, run_cfg, sim_cfg, faults=faults, label=label)
+        out.append((result.metrics(world), result.path[:, :2].round(4).tolist()))
+    if plot_dir is not None:
+        plot_trajectories(world, {r['method']: np.asarray(p) for r, p in out},
+                          {r['method']: r['outcome'] for r, _ in out},
+                          Path(plot_dir) / f'{world.name}.png')
+    return out
+
+
+def paired(runs: list[dict], methods: list[str]) -> str:
+    """Each method against the first on the worlds both reach: mean curvature and time."""
+    if len(methods) < 2:
+        return ''
+    reached = {(r['method'], r['world']): r for r in runs if r['outcome'] == 'reached'}
+    ref = methods[0]
+    lines = [f'| on worlds both reach | worlds | mean curvature [1/m] ({ref} / other) '
+             f'| mean time [s] ({ref} / other) |', '|---|---|---|---|']
+    for m in methods[1:]:
+        both = sorted({w for (mm, w) in reached if mm == m} & {w for (mm, w) in reached
+                                                                if mm == ref})
+        if not both:
+            lines.append(f'| {m} | 0 | - | - |')
+            continue
+
+        def mean(key: str, meth: str, both: list[str] = both) -> float:
+            return statistics.fmean(reached[(meth, w)][key] for w in both)
+        lines.append(f'| {m} | {len(both)} | {mean("mean_abs_curvature", ref):.2f} / '
+                     f'{mean("mean_abs_curvature", m):.2f} | {mean("time_s", ref):.1f} / '
+                     f'{mean("time_s", m):.1f} |')
+    return '\n'.join(lines) + '\n'
 
 
 def summarise(runs: list[dict], methods: list[str]) -> str:
@@ -71,8 +129,9 @@ def summarise(runs: list[dict], methods: list[str]) -> str:
 def parse_args(argv: list[str] | None) -> argparse.Namespace:
     p = argparse.ArgumentParser(prog='subapf-bench', description=__doc__.splitlines()[0])
     p.add_argument('worlds', nargs='*', help='world files or directories (default: shipped)')
-    p.add_argument('--methods', default=','.join(METHODS),
-                   help=f'comma-separated, of {",".join(METHODS)}')
+    p.add_argument('--methods', default=','.join(DEFAULT_METHODS),
+                   help='comma-separated method[:geodesic|:euclidean] (attraction field; '
+                   f'default: the params file\'s), of {",".join(METHODS)}')
     p.add_argument('--out', required=True, help='output directory')
     p.add_argument('--params', default=None, help='ROS 2 params YAML (config/planner.yaml)')
     p.add_argument('--jobs', type=int, default=1, help='worker processes')
@@ -90,13 +149,12 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
 
 def main(argv: list[str] | None = None) -> int:
     args = parse_args(argv)
-    methods = [m.strip() for m in args.methods.split(',') if m.strip()]
-    bad = [m for m in methods if m not in METHODS]
-    if bad or not methods:
-        print(f'subapf-bench: unknown method(s) {bad}; choose from {", ".join(METHODS)}',
-              file=sys.stderr)
-        return 2
     try:
+        methods = [m.strip() for m in args.methods.split(',') if m.strip()]
+        if not methods:
+            raise ValueError('no method given')
+        for m in methods:
+            parse_method(m)
         cfg = load_config(args.params or default_params_file())
         sim_cfg = SimConfig(seed=args.seed, range_noise=args.noise,
                             beam_dropout=args.beam_dropout)
@@ -111,26 +169,22 @@ def main(argv: list[str] | None = None) -> int:
         return 2
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
-    jobs = [(f, m, cfg, sim_cfg, faults) for f in worlds for m in methods]
+    plot_dir = None if args.no_plots else str(out)
+    jobs = [(f, methods, cfg, sim_cfg, faults, plot_dir) for f in worlds]
     t0 = time.perf_counter()
     with ProcessPoolExecutor(max_workers=max(1, args.jobs)) as pool:
-        results = list(tqdm(pool.map(_run, jobs), total=len(jobs), unit='run',
-                            desc='subapf-bench', file=sys.stderr))
+        per_world = list(tqdm(pool.map(_run_world, jobs), total=len(jobs), unit='world',
+                              desc='subapf-bench', file=sys.stderr))
     wall = time.perf_counter() - t0
-    runs = [r for r, _ in results]
-    doc = {'runs': runs, 'methods': methods, 'seed': args.seed, 'noise': args.noise,
+    runs = [r for world_runs in per_world for r, _ in world_runs]
+    labels = list(dict.fromkeys(r['method'] for r in runs))
+    doc = {'runs': runs, 'methods': labels, 'seed': args.seed, 'noise': args.noise,
            'beam_dropout': args.beam_dropout, 'scan_dropout': args.scan_dropout,
            'scan_latency': args.scan_latency, 'wall_time_s': round(wall, 2),
-           'params': {k: v for k, v in cfg.__dict__.items() if k != 'method'}}
+           'params': dataclasses.asdict(cfg)}
     (out / 'results.json').write_text(json.dumps(doc, indent=1))
-    (out / 'summary.md').write_text(summarise(runs, methods)
+    (out / 'summary.md').write_text(summarise(runs, labels) + '\n' + paired(runs, labels)
                                     + f'\n{len(runs)} runs in {wall:.1f} s wall time.\n')
-    if not args.no_plots:
-        for f, world in worlds.items():
-            sel = [(job, res) for job, res in zip(jobs, results, strict=True) if job[0] == f]
-            plot_trajectories(world, {j[1]: np.asarray(p) for j, (_, p) in sel},
-                              {j[1]: r['outcome'] for j, (r, _) in sel},
-                              out / f'{world.name}.png')
     print((out / 'summary.md').read_text())
     return 0
 

@@ -2,7 +2,7 @@
 
 Fig. 1: potential of four point obstacles at (+-1, +-1), ``+sum 1/r`` (a strict
 local minimum at the origin) against ``-sum log10 r`` (a saddle), plus the
-exponential sum, which also has a local minimum there (NOTES.md section 3).
+exponential sum, which also has a local minimum there (docs/paper_notes.md section 3).
 Fig. 2: |d phi/d r| of the three repulsions against distance.
 Fig. 3: raw APF iterations (no robot dynamics, no sampling) in the narrowing
 passage world, one trajectory per repulsion.

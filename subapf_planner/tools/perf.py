@@ -1,7 +1,11 @@
-"""``subapf-perf``: planning-cycle time of the core (a benchmark, not a test).
+"""``subapf-perf``: planning-cycle time of the decision loop (a benchmark, not a test).
 
-Feeds recorded-like 360-beam scans (from the simulator on a shipped world)
-through ``Planner.step_scan`` and prints min / median / p99 per cycle in ms.
+Drives closed-loop episodes (sim/episode.py: the node's controller, 360-beam
+scans from the simulator) on the given worlds and prints min / median / p99 /
+max of the time per planning cycle in ms: the whole tick, i.e. with the
+geodesic default the occupancy update, the navigation field when it is
+recomputed, the APF step, the sampling and the command. Also prints the
+memory the occupancy window and the largest field hold.
 """
 
 from __future__ import annotations
@@ -13,42 +17,43 @@ import time
 import numpy as np
 
 from ..core.config import METHODS, load_config
-from ..core.planner import Planner
-from ..sim.simulator import BurgerSim, SimConfig
-from ..sim.world import load_world
+from ..sim.episode import run_episode
+from ..sim.simulator import SimConfig
+from ..sim.world import load_world, world_files
 from .paths import default_params_file, shipped_worlds_dir
+
+#: Bytes per field cell: values (float64), descent (2 x float64), passable (bool).
+FIELD_BYTES_PER_CELL = 8 + 16 + 1
 
 
 def main(argv: list[str] | None = None) -> int:
     p = argparse.ArgumentParser(prog='subapf-perf', description=__doc__.splitlines()[0])
-    p.add_argument('--cycles', type=int, default=5000)
+    p.add_argument('worlds', nargs='*', help='world files or folders (default: shipped)')
     p.add_argument('--method', default='subharmonic_sampling', choices=METHODS)
-    p.add_argument('--samples', type=int, default=16, help='num_samples')
-    p.add_argument('--world', default=None, help='world file (default: cluttered_field)')
+    p.add_argument('--field', default=None, choices=('geodesic', 'euclidean'),
+                   help="attraction field (default: the params file's)")
+    p.add_argument('--params', default=None, help='params YAML (default: config/planner.yaml)')
     args = p.parse_args(argv)
-    cfg = load_config(default_params_file(), method=args.method, num_samples=args.samples)
-    world = load_world(args.world or shipped_worlds_dir() / 'cluttered_field.yaml')
-    with BurgerSim(world, SimConfig(range_noise=0.01)) as sim:
-        scans, poses = [], []
-        for _ in range(50):
-            sim.set_command(0.15, 0.3)
-            sim.step(0.2)
-            scans.append(sim.scan())
-            poses.append(sim.odometry()[0])
-    planner = Planner(cfg)
-    goal = np.asarray(world.goal)
-    times = np.empty(args.cycles)
-    for i in range(args.cycles):
-        s, pose = scans[i % len(scans)], poses[i % len(poses)]
-        t0 = time.perf_counter()
-        planner.step_scan(pose, goal, s.ranges, s.angle_min, s.angle_increment,
-                          s.range_min, s.range_max)
-        times[i] = time.perf_counter() - t0
-    ms = times * 1e3
-    print(f'method={args.method} beams={scans[0].ranges.size} samples={cfg.num_samples} '
-          f'cycles={args.cycles}')
+    changes = {'method': args.method}
+    if args.field:
+        changes['attraction_field'] = args.field
+    cfg = load_config(args.params or default_params_file(), **changes)
+    files = world_files(args.worlds or [shipped_worlds_dir()])
+    t0 = time.perf_counter()
+    ms = []
+    for f in files:
+        ms.append(run_episode(load_world(f), cfg, SimConfig(range_noise=0.01)).plan_ms)
+    ms = np.concatenate(ms)
+    cells = int(np.ceil(cfg.map_size / cfg.map_resolution)) ** 2
+    print(f'method={cfg.method} attraction_field={cfg.attraction_field} '
+          f'map={cfg.map_size:g} m at {cfg.map_resolution:g} m ({cells} cells) '
+          f'field_period={cfg.field_period:g} s worlds={len(files)} cycles={ms.size} '
+          f'({time.perf_counter() - t0:.0f} s)')
     print(f'plan cycle ms: min {ms.min():.3f}  median {np.median(ms):.3f}  '
-          f'p99 {np.percentile(ms, 99):.3f}')
+          f'p99 {np.percentile(ms, 99):.3f}  max {ms.max():.3f}')
+    if cfg.geodesic:
+        print(f'memory: occupancy window {cells * 4 / 2**20:.2f} MiB (float32), field at most '
+              f'{cells * FIELD_BYTES_PER_CELL / 2**20:.2f} MiB (the whole window)')
     return 0
 
 

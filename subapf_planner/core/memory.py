@@ -1,0 +1,97 @@
+"""The planner's memory: the occupancy grid and the navigation field on it.
+
+Integrates each scan once (at the laser's odom pose when it was taken) and
+recomputes the field when the goal changes, when the robot leaves the patch
+the field covers, or, when the grid changed, at most every ``field_period``
+seconds (the field is the expensive part of a cycle; core/navigation.py).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from .config import PlannerConfig
+from .navigation import NavigationField, compute_field
+from .occupancy import OccupancyGrid
+
+#: Goals closer than this to the one the field was computed for are the same [m].
+SAME_GOAL = 1e-3
+
+
+def laser_pose(pose: ArrayLike, cfg: PlannerConfig) -> tuple[float, float, float]:
+    """base_scan in odom from base_footprint's odom pose (x, y, yaw) and the mounting."""
+    x, y, yaw = (float(v) for v in pose)
+    c, s = math.cos(yaw), math.sin(yaw)
+    return (x + c * cfg.laser_x - s * cfg.laser_y, y + s * cfg.laser_x + c * cfg.laser_y,
+            yaw + cfg.laser_yaw)
+
+
+class NavigationMemory:
+    """Occupancy grid + navigation field for one robot. Not thread-safe."""
+
+    def __init__(self, cfg: PlannerConfig) -> None:
+        self.cfg = cfg
+        self.grid = OccupancyGrid(cfg.map_resolution, cfg.map_size)
+        self.field: NavigationField | None = None
+        self._field_key: tuple | None = None    # (goal, grid version) of self.field
+        self._field_time = -math.inf
+        self._scan_stamp: float | None = None
+        self.recomputed = False   # whether the last field_for() computed a new field
+
+    def reconfigure(self, cfg: PlannerConfig) -> None:
+        """A new configuration; a new map size or resolution starts an empty map."""
+        if (cfg.map_size, cfg.map_resolution) != (self.cfg.map_size, self.cfg.map_resolution):
+            self.cfg = cfg
+            self.forget()
+        self.cfg = cfg
+        self._field_key = None
+
+    def forget(self) -> None:
+        """Drop the map and the field (the world may have changed: a restarted simulation)."""
+        self.grid = OccupancyGrid(self.cfg.map_resolution, self.cfg.map_size)
+        self.field, self._field_key, self._field_time = None, None, -math.inf
+        self._scan_stamp = None
+
+    def integrate(self, ranges: ArrayLike, angle_min: float, angle_increment: float,
+                  range_min: float, range_max: float, scan_pose: ArrayLike, stamp: float,
+                  goal: ArrayLike | None = None) -> bool:
+        """Add a scan taken from ``scan_pose`` at ``stamp`` [s] unless it was added already."""
+        if self._scan_stamp is not None and stamp == self._scan_stamp:
+            return False
+        self._scan_stamp = stamp
+        self.grid.follow(scan_pose, goal)
+        self.grid.update(ranges, angle_min, angle_increment, range_min, range_max,
+                         laser_pose(scan_pose, self.cfg), self.cfg.obstacle_range)
+        return True
+
+    def _covers(self, position: np.ndarray) -> bool:
+        f = self.field
+        if f is None:
+            return False
+        h, w = f.values.shape
+        rel = (position - f.origin) / f.resolution
+        return bool(0 <= rel[0] < w and 0 <= rel[1] < h)
+
+    def field_for(self, position: ArrayLike, goal: ArrayLike,
+                  now: float | None = None) -> NavigationField | None:
+        """The field to ``goal`` (None: the goal is blocked in the map), recomputed per the
+        module docstring; ``now`` None recomputes whenever the grid changed."""
+        p = np.asarray(position, float)[:2]
+        g = np.asarray(goal, float)[:2]
+        key = (tuple(np.round(g / SAME_GOAL).astype(int)), self.grid.version)
+        same_goal = self._field_key is not None and self._field_key[0] == key[0]
+        fresh = same_goal and (key[1] == self._field_key[1] or (
+            now is not None and now - self._field_time < self.cfg.field_period))
+        self.recomputed = False
+        if fresh and (self.field is None or self._covers(p)):
+            return self.field
+        cfg = self.cfg
+        self.field = compute_field(self.grid.occupied(), self.grid.origin, self.grid.resolution,
+                                   g, p, cfg.inflation_radius, cfg.inflation_band)
+        self._field_key = key
+        self._field_time = -math.inf if now is None else now
+        self.recomputed = True
+        return self.field

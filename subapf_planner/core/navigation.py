@@ -1,0 +1,228 @@
+"""Navigation-function attraction: the distance to the goal through free space.
+
+A navigation function has one minimum, the goal (Rimon and Koditschek 1992);
+on a grid, the distance to the goal through free cells is one: every cell from
+which the goal can be reached has a neighbour closer to it (NF1, Latombe 1991;
+docs/paper_notes.md section 5). It replaces the Euclidean attraction of eq. (21)
+in the APF step and in the sampling scores, so the potential the robot descends
+has no local minimum but the goal; eq. (13)'s repulsion and the circular
+sampling stay as the local layer that keeps the path smooth and clear.
+
+Computed by fast marching (scikit-fmm, Sethian 1996), which solves the eikonal
+equation |grad T| = 1 / speed and is close to Euclidean (8-connected Dijkstra
+overestimates by up to 8 %). Only occupied cells are walls of the field; the
+speed is ``MIN_SPEED`` within ``robot_radius`` of them (a robot found there is
+led out, not stranded), then rises linearly to 1 at ``robot_radius +
+clearance_band``: the field keeps to the middle of passages and takes a
+narrow one only when going round costs more. Whether the goal can be reached at
+all is decided on the hard inflation: the free cells at least ``robot_radius``
+from every occupied cell, connected (``reachable``). The field is computed on
+the part of the grid that matters: the bounding box of the occupied cells, the
+robot and the goal, grown by ``CROP_MARGIN`` (outside it everything is unknown,
+i.e. free, so the box changes no route through obstacles).
+Units: values in metres of free-space travel (seconds at 1 m/s).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+import math
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+from scipy import ndimage
+import skfmm
+
+#: Speed within robot_radius of an occupied cell (relative; 1 in open space).
+MIN_SPEED = 0.02
+#: Free border kept around the box the field is computed on [m].
+CROP_MARGIN = 1.0
+#: The 8 neighbours (d_row, d_col) and their lengths in cells.
+NEIGHBOURS = np.array([(-1, -1), (-1, 0), (-1, 1), (0, -1), (0, 1), (1, -1), (1, 0), (1, 1)])
+NEIGHBOUR_LENGTH = np.hypot(NEIGHBOURS[:, 0], NEIGHBOURS[:, 1])
+
+
+@dataclass(frozen=True)
+class NavigationField:
+    """Distance to ``goal`` [m] on a grid patch, inf where blocked or cut off.
+
+    ``origin`` is the odom corner of cell (0, 0); rows are y, columns x.
+    ``descent`` (rows, cols, 2) is the unit direction of steepest descent in odom
+    (x, y), zero where there is none (blocked cells, the goal).
+    """
+
+    origin: NDArray[np.float64]
+    resolution: float
+    values: NDArray[np.float64]
+    descent: NDArray[np.float64]
+    goal: NDArray[np.float64]
+    #: Cells (rows, cols) connected to the goal through the hard-inflated free space.
+    passable: NDArray[np.bool_]
+
+    def reachable(self, point: ArrayLike, radius_cells: int = 3) -> bool:
+        """Whether the goal can be reached from ``point`` (a cell within ``radius_cells``
+        of it is connected to the goal at the hard inflation)."""
+        h, w = self.passable.shape
+        c = np.floor((np.asarray(point, float)[:2] - self.origin) / self.resolution).astype(int)
+        r0, r1 = max(c[1] - radius_cells, 0), min(c[1] + radius_cells + 1, h)
+        c0, c1 = max(c[0] - radius_cells, 0), min(c[0] + radius_cells + 1, w)
+        return bool(r0 < r1 and c0 < c1 and self.passable[r0:r1, c0:c1].any())
+
+    @property
+    def goal_reachable_cells(self) -> int:
+        return int(np.isfinite(self.values).sum())
+
+    def _corners(self, points: ArrayLike) -> tuple[NDArray, NDArray, NDArray]:
+        """Bilinear corners: (rows (n,4), cols (n,4), weights (n,4)), clipped to the patch."""
+        p = np.atleast_2d(np.asarray(points, float))
+        g = (p - self.origin) / self.resolution - 0.5   # continuous (col, row) of centres
+        c0 = np.floor(g).astype(np.int64)
+        f = g - c0
+        rows = np.stack([c0[:, 1], c0[:, 1], c0[:, 1] + 1, c0[:, 1] + 1], axis=1)
+        cols = np.stack([c0[:, 0], c0[:, 0] + 1, c0[:, 0], c0[:, 0] + 1], axis=1)
+        w = np.stack([(1 - f[:, 0]) * (1 - f[:, 1]), f[:, 0] * (1 - f[:, 1]),
+                      (1 - f[:, 0]) * f[:, 1], f[:, 0] * f[:, 1]], axis=1)
+        h, wd = self.values.shape
+        inside = (rows >= 0) & (rows < h) & (cols >= 0) & (cols < wd)
+        return np.clip(rows, 0, h - 1), np.clip(cols, 0, wd - 1), np.where(inside, w, 0.0)
+
+    def value(self, points: ArrayLike) -> NDArray[np.float64]:
+        """Field at each point (n,) [m], bilinear over the finite corners; inf where no
+        corner is finite (inside an inflated obstacle, or off the patch)."""
+        rows, cols, w = self._corners(points)
+        v = self.values[rows, cols]
+        ok = np.isfinite(v) & (w > 0)
+        wsum = np.sum(np.where(ok, w, 0.0), axis=1)
+        num = np.sum(np.where(ok, w * np.where(ok, v, 0.0), 0.0), axis=1)
+        with np.errstate(invalid='ignore', divide='ignore'):
+            return np.where(wsum > 1e-9, num / np.maximum(wsum, 1e-12), np.inf)
+
+    def direction(self, points: ArrayLike) -> NDArray[np.float64]:
+        """Unit descent direction at each point (n, 2); where the point's corners have
+        none (inside an inflated obstacle), the direction to the nearest cell that has
+        one, within a few cells; zero when there is none either."""
+        p = np.atleast_2d(np.asarray(points, float))
+        rows, cols, w = self._corners(p)
+        d = np.sum(self.descent[rows, cols] * w[..., None], axis=1)
+        norm = np.linalg.norm(d, axis=1)
+        out = np.where(norm[:, None] > 1e-9, d / np.maximum(norm, 1e-12)[:, None], 0.0)
+        for i in np.flatnonzero(norm <= 1e-9):
+            out[i] = self._towards_free(p[i])
+        return out
+
+    def _towards_free(self, point: NDArray[np.float64], radius_cells: int = 6) -> NDArray:
+        h, wd = self.values.shape
+        c = np.floor((point - self.origin) / self.resolution).astype(int)   # (col, row)
+        r0, r1 = max(c[1] - radius_cells, 0), min(c[1] + radius_cells + 1, h)
+        c0, c1 = max(c[0] - radius_cells, 0), min(c[0] + radius_cells + 1, wd)
+        if r0 >= r1 or c0 >= c1:
+            return np.zeros(2)
+        patch = self.values[r0:r1, c0:c1]
+        if not np.any(np.isfinite(patch)):
+            return np.zeros(2)
+        rr, cc = np.nonzero(np.isfinite(patch))
+        centres = self.origin + (np.column_stack((cc + c0, rr + r0)) + 0.5) * self.resolution
+        # nearest free cell, ties to the lower field value
+        dist = np.hypot(*(centres - point).T)
+        k = np.lexsort((patch[rr, cc], np.round(dist / self.resolution, 3)))[0]
+        v = centres[k] - point
+        n = float(np.hypot(*v))
+        return v / n if n > 1e-9 else np.zeros(2)
+
+    def path(self, start: ArrayLike, max_length: float = 30.0) -> NDArray[np.float64]:
+        """Steepest-descent polyline (k, 2) [m] from ``start`` along the grid (each step to
+        the lowest 8-neighbour) until the goal cell or ``max_length``; empty when the
+        start has no finite value nearby."""
+        h, wd = self.values.shape
+        p = np.asarray(start, float)[:2]
+        c = np.floor((p - self.origin) / self.resolution).astype(int)[::-1]   # (row, col)
+        if not (0 <= c[0] < h and 0 <= c[1] < wd) or not np.isfinite(self.values[c[0], c[1]]):
+            return np.zeros((0, 2))
+        cells = [c]
+        for _ in range(int(max_length / self.resolution)):
+            nb = cells[-1] + NEIGHBOURS
+            ok = (nb[:, 0] >= 0) & (nb[:, 0] < h) & (nb[:, 1] >= 0) & (nb[:, 1] < wd)
+            vals = np.full(8, np.inf)
+            vals[ok] = self.values[nb[ok, 0], nb[ok, 1]]
+            k = int(np.argmin(vals))
+            if not vals[k] < self.values[cells[-1][0], cells[-1][1]]:
+                break
+            cells.append(nb[k])
+        rc = np.asarray(cells, float)
+        return self.origin + (rc[:, ::-1] + 0.5) * self.resolution
+
+
+def descent_directions(values: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Unit steepest-descent direction per cell (rows, cols, 2) as (x, y): the sum of the
+    unit vectors to the 8 neighbours weighted by how much lower each is per metre;
+    blocked (inf) neighbours never count."""
+    h, w = values.shape
+    padded = np.pad(values, 1, constant_values=np.inf)
+    acc = np.zeros((h, w, 2))
+    with np.errstate(invalid='ignore'):
+        for (dr, dc), length in zip(NEIGHBOURS, NEIGHBOUR_LENGTH, strict=True):
+            nb = padded[1 + dr:1 + dr + h, 1 + dc:1 + dc + w]
+            drop = np.where(np.isfinite(values) & np.isfinite(nb), values - nb, 0.0)
+            slope = np.maximum(drop, 0.0) / length
+            acc[..., 0] += slope * dc / length
+            acc[..., 1] += slope * dr / length
+    norm = np.linalg.norm(acc, axis=2, keepdims=True)
+    return np.where(norm > 1e-12, acc / np.maximum(norm, 1e-12), 0.0)
+
+
+def crop_box(occupied: NDArray[np.bool_], cells: NDArray[np.int64],
+             margin: int) -> tuple[int, int, int, int]:
+    """(r0, r1, c0, c1): the box of the occupied cells and ``cells`` (k, 2), grown by
+    ``margin`` cells and clipped to the grid."""
+    rows, cols = np.nonzero(occupied)
+    rs = np.concatenate([rows, cells[:, 0]])
+    cs = np.concatenate([cols, cells[:, 1]])
+    h, w = occupied.shape
+    return (max(int(rs.min()) - margin, 0), min(int(rs.max()) + margin + 1, h),
+            max(int(cs.min()) - margin, 0), min(int(cs.max()) + margin + 1, w))
+
+
+def compute_field(occupied: NDArray[np.bool_], origin: ArrayLike, resolution: float,
+                  goal: ArrayLike, robot: ArrayLike, robot_radius: float,
+                  clearance_band: float) -> NavigationField | None:
+    """The navigation field to ``goal`` on an occupancy grid (see the module docstring).
+
+    ``goal`` outside the grid is replaced by the nearest cell of the grid's border.
+    Returns None when the goal cell is within ``robot_radius`` of an occupied cell.
+    """
+    origin = np.asarray(origin, float)
+    h, w = occupied.shape
+    g = np.asarray(goal, float)[:2]
+
+    def cell(p: ArrayLike) -> NDArray[np.int64]:
+        c = np.floor((np.asarray(p, float)[:2] - origin) / resolution).astype(int)[::-1]
+        return np.clip(c, 0, [h - 1, w - 1])
+
+    gc, rc = cell(g), cell(robot)
+    margin = int(math.ceil((CROP_MARGIN + robot_radius + clearance_band) / resolution))
+    r0, r1, c0, c1 = crop_box(occupied, np.array([gc, rc]), margin)
+    occ = occupied[r0:r1, c0:c1]
+    clear = ndimage.distance_transform_edt(~occ) * resolution if occ.any() \
+        else np.full(occ.shape, np.inf)
+    free = clear >= robot_radius
+    g_local = (gc[0] - r0, gc[1] - c0)
+    if not free[g_local]:
+        return None
+    labels, _ = ndimage.label(free, structure=np.ones((3, 3)))
+    passable = labels == labels[g_local]
+    speed = np.clip((clear - robot_radius) / max(clearance_band, 1e-9), MIN_SPEED, 1.0)
+    phi = np.ones(occ.shape)
+    phi[g_local] = -1.0
+    try:
+        t = skfmm.travel_time(np.ma.MaskedArray(phi, occ), speed, dx=resolution)
+    except ValueError:   # no zero contour left after masking (degenerate patch)
+        return None
+    values = np.ma.filled(np.ma.masked_invalid(t).astype(float), np.inf)
+    values[g_local] = 0.0
+    values = np.maximum(values, 0.0)
+    patch_origin = origin + np.array([c0, r0]) * resolution
+    goal_used = g if (0 <= (g - origin)[0] < w * resolution
+                      and 0 <= (g - origin)[1] < h * resolution) \
+        else origin + (gc[::-1] + 0.5) * resolution
+    return NavigationField(patch_origin, resolution, values, descent_directions(values),
+                           goal_used, passable)

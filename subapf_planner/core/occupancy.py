@@ -1,0 +1,171 @@
+"""Occupancy memory: a log-odds grid in ``odom`` built from every scan.
+
+The paper's planner has no memory, so it cannot tell it has been somewhere
+before, and a potential made of the distance to the goal plus obstacle terms
+has minima wherever obstacles close a pocket (docs/paper_notes.md section 3).
+This grid is what the navigation field (core/navigation.py) is computed on.
+
+Update rule, per beam of a scan taken at the laser's odom pose:
+
+* a valid return (finite, in [range_min, range_max)) adds ``hit`` to the log
+  odds of its end cell and ``miss`` to every cell the beam crossed before it;
+* a ``+inf`` return (no echo within range) adds ``miss`` along the whole beam up
+  to ``clear_range`` (at most range_max): open space is forgotten obstacles;
+* NaN, 0.0, negative and below-range_min returns are not evidence of anything
+  (LDS-01 and LDS-02 invalid beams) and change nothing.
+
+Log odds are clamped to [LOG_ODDS_MIN, LOG_ODDS_MAX], so a wall seen many
+times stays after a few dropped beams, and a thing that moved away is
+forgotten after a few scans through it. A cell is occupied when its log odds
+are above 0; unknown cells (0) count as free (optimistic, as D* Lite).
+
+Memory is bounded: the grid is a square window of ``size`` metres that
+follows the robot (and reaches towards the goal); what leaves it is forgotten.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from .scan import beam_angles, valid_beams
+
+#: Log-odds increments and clamps (a hit outweighs two misses).
+HIT = 0.9
+MISS = -0.4
+LOG_ODDS_MIN = -2.0
+LOG_ODDS_MAX = 3.5
+#: Distance kept between the robot and the window's edge before it recentres [m].
+EDGE_MARGIN = 3.0
+
+
+class OccupancyGrid:
+    """A ``size`` x ``size`` m log-odds window at ``resolution`` m, in odom.
+
+    ``origin`` is the odom position of the corner of cell (0, 0); cell (i, j)
+    covers x in [ox + j*res, ox + (j+1)*res), y in [oy + i*res, ...) (row = y).
+    Not thread-safe; one per robot.
+    """
+
+    def __init__(self, resolution: float, size: float) -> None:
+        if not (math.isfinite(resolution) and resolution > 0.0):
+            raise ValueError(f'map resolution must be positive, got {resolution}')
+        self.resolution = float(resolution)
+        self.cells = max(8, int(math.ceil(size / resolution)))
+        self.log_odds = np.zeros((self.cells, self.cells), np.float32)
+        self.origin = np.array([-0.5, -0.5]) * self.cells * self.resolution
+        self.version = 0   # bumped whenever the occupied set may have changed
+
+    # --- geometry ---------------------------------------------------------------------
+    @property
+    def size(self) -> float:
+        """Side of the window [m]."""
+        return self.cells * self.resolution
+
+    @property
+    def nbytes(self) -> int:
+        """Memory held by the grid [bytes]."""
+        return int(self.log_odds.nbytes)
+
+    def cell_of(self, points: ArrayLike) -> NDArray[np.int64]:
+        """(row, col) of each point (n, 2) [m]; may lie outside the window."""
+        p = np.atleast_2d(np.asarray(points, float))
+        return np.floor((p[:, ::-1] - self.origin[::-1]) / self.resolution).astype(np.int64)
+
+    def centre_of(self, cells: ArrayLike) -> NDArray[np.float64]:
+        """Odom position of cell centres (n, 2) from (row, col)."""
+        c = np.atleast_2d(np.asarray(cells, float))
+        return self.origin + (c[:, ::-1] + 0.5) * self.resolution
+
+    def inside(self, cells: NDArray[np.int64]) -> NDArray[np.bool_]:
+        return np.all((cells >= 0) & (cells < self.cells), axis=1)
+
+    def occupied(self) -> NDArray[np.bool_]:
+        """Occupied cells (log odds > 0), a new array."""
+        return self.log_odds > 0.0
+
+    # --- following the robot ----------------------------------------------------------
+    def follow(self, robot: ArrayLike, goal: ArrayLike | None = None) -> bool:
+        """Recentre the window when its centre is more than EDGE_MARGIN (at most a quarter
+        of the window) from where it should be: the robot-goal midpoint when both fit
+        with that margin, else the robot shifted towards the goal as far as the margin
+        allows. Returns whether it moved."""
+        r = np.asarray(robot, float)[:2]
+        half = 0.5 * self.size
+        margin = min(EDGE_MARGIN, 0.25 * self.size)
+        target = r
+        if goal is not None:
+            g = np.asarray(goal, float)[:2]
+            if np.all(np.abs(g - r) <= self.size - 2 * margin):
+                target = 0.5 * (r + g)
+            else:
+                target = r + np.clip(g - r, -(half - margin), half - margin)
+        if np.all(np.abs(target - (self.origin + half)) <= margin):
+            return False
+        self._shift_to(target)
+        return True
+
+    def _shift_to(self, centre: NDArray[np.float64]) -> None:
+        new_origin = np.round((centre - 0.5 * self.size) / self.resolution) * self.resolution
+        d = np.round((new_origin - self.origin) / self.resolution).astype(int)  # (dx, dy)
+        n = self.cells
+        shifted = np.zeros_like(self.log_odds)
+        dx, dy = int(d[0]), int(d[1])
+        if abs(dx) < n and abs(dy) < n:
+            src_r = slice(max(dy, 0), n + min(dy, 0))
+            dst_r = slice(max(-dy, 0), n + min(-dy, 0))
+            src_c = slice(max(dx, 0), n + min(dx, 0))
+            dst_c = slice(max(-dx, 0), n + min(-dx, 0))
+            shifted[dst_r, dst_c] = self.log_odds[src_r, src_c]
+        self.log_odds = shifted
+        self.origin = new_origin
+        self.version += 1
+
+    # --- scans ------------------------------------------------------------------------
+    def update(self, ranges: ArrayLike, angle_min: float, angle_increment: float,
+               range_min: float, range_max: float, laser_pose: ArrayLike,
+               clear_range: float = math.inf) -> None:
+        """Integrate one scan taken with the laser at ``laser_pose`` (x, y, yaw) in odom
+        (see the module docstring for the rule). Geometry is assumed checked
+        (core/scan.scan_to_points refuses bad scans before this is called)."""
+        r = np.asarray(ranges, float).ravel()
+        lx, ly, lyaw = (float(v) for v in laser_pose)
+        angles = beam_angles(r.size, angle_min, angle_increment) + lyaw
+        hit = valid_beams(r, range_min, range_max)
+        reach = min(range_max, clear_range)
+        with np.errstate(invalid='ignore'):
+            open_beam = np.isposinf(r) & (reach > range_min)
+        lengths = np.where(hit, r, np.where(open_beam, reach, 0.0))
+        use = hit | open_beam
+        if not np.any(use):
+            return
+        a, length = angles[use], lengths[use]
+        direction = np.column_stack((np.cos(a), np.sin(a)))
+        step = self.resolution
+        s = np.arange(0.5 * step, float(length.max()), step)
+        # free samples stop half a cell before a return, so its own cell is not cleared
+        stop = np.where(hit[use], length - 0.5 * step, length)
+        keep = s[None, :] < stop[:, None]
+        origin = np.array([lx, ly])
+        free = self._flat(origin + direction[:, None, :] * s[None, :, None], keep)
+        ends = self._flat(origin + direction[hit[use]] * length[hit[use], None])
+        # fancy-index assignment applies once per cell however many beams touch it
+        delta = np.zeros(self.log_odds.size, np.float32)
+        delta[free] = MISS
+        delta[ends] = HIT
+        self.log_odds += delta.reshape(self.log_odds.shape)
+        np.clip(self.log_odds, LOG_ODDS_MIN, LOG_ODDS_MAX, out=self.log_odds)
+        self.version += 1
+
+    def _flat(self, points: NDArray[np.float64],
+              keep: NDArray[np.bool_] | None = None) -> NDArray[np.int64]:
+        """Flat indices (with repeats) of the cells of ``points`` (..., 2) inside the window,
+        only where ``keep``."""
+        col = np.floor((points[..., 0] - self.origin[0]) / self.resolution).astype(np.int64)
+        row = np.floor((points[..., 1] - self.origin[1]) / self.resolution).astype(np.int64)
+        ok = (row >= 0) & (row < self.cells) & (col >= 0) & (col < self.cells)
+        if keep is not None:
+            ok &= keep
+        return row[ok] * self.cells + col[ok]

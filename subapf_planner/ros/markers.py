@@ -1,0 +1,70 @@
+"""RViz/Foxglove markers of one planning cycle: what the planner saw and chose."""
+
+from __future__ import annotations
+
+import math
+
+from builtin_interfaces.msg import Time
+from geometry_msgs.msg import Point
+import numpy as np
+from std_msgs.msg import ColorRGBA
+from visualization_msgs.msg import Marker, MarkerArray
+
+from ..core.planner import PlanResult
+from ..core.scan import voxel_downsample
+
+
+def _marker(ns: str, mid: int, mtype: int, frame: str, stamp: Time, scale: float,
+            rgba: tuple[float, float, float, float]) -> Marker:
+    m = Marker()
+    m.header.frame_id = frame
+    m.header.stamp = stamp
+    m.ns, m.id, m.type, m.action = ns, mid, mtype, Marker.ADD
+    m.pose.orientation.w = 1.0
+    m.scale.x = m.scale.y = m.scale.z = scale
+    m.color = ColorRGBA(r=rgba[0], g=rgba[1], b=rgba[2], a=rgba[3])
+    return m
+
+
+def _points(xy: np.ndarray) -> list[Point]:
+    return [Point(x=float(x), y=float(y), z=0.0) for x, y in np.asarray(xy).reshape(-1, 2)]
+
+
+def markers_from_result(result: PlanResult, frame: str, stamp: Time,
+                        danger_distance: float, position: np.ndarray,
+                        voxel: float = 0.05) -> MarkerArray:
+    """Obstacle points (voxel-downsampled, as the repulsion sees them), raw next move
+    point, samples coloured by score, chosen point and the danger circle around the
+    robot, for RViz or Foxglove."""
+    out = MarkerArray()
+    obs = _marker('obstacles', 0, Marker.POINTS, frame, stamp, 0.03, (0.9, 0.2, 0.2, 1.0))
+    obs.points = _points(voxel_downsample(result.obstacles, voxel))
+    out.markers.append(obs)
+    for ns, point, rgba in (('raw_point', result.raw_point, (1.0, 0.6, 0.0, 1.0)),
+                            ('chosen_point', result.chosen_point, (0.0, 0.8, 0.0, 1.0))):
+        m = _marker(ns, 0, Marker.SPHERE, frame, stamp, 0.04, rgba)
+        if point is None:
+            m.action = Marker.DELETE
+        else:
+            m.pose.position.x, m.pose.position.y = float(point[0]), float(point[1])
+        out.markers.append(m)
+    samples = _marker('samples', 0, Marker.POINTS, frame, stamp, 0.02, (0.2, 0.2, 1.0, 1.0))
+    if result.sampling is not None:
+        samples.points = _points(result.sampling.samples)
+        scores = result.sampling.scores
+        finite = scores[np.isfinite(scores)]
+        lo, hi = (finite.min(), finite.max()) if finite.size else (0.0, 1.0)
+        for s in scores:
+            if not np.isfinite(s):
+                samples.colors.append(ColorRGBA(r=0.3, g=0.3, b=0.3, a=0.6))
+            else:
+                t = float((s - lo) / (hi - lo)) if hi > lo else 0.0
+                samples.colors.append(ColorRGBA(r=t, g=1.0 - t, b=0.2, a=1.0))
+    out.markers.append(samples)
+    ring = _marker('danger_circle', 0, Marker.LINE_STRIP, frame, stamp, 0.01,
+                   (1.0, 0.0, 0.0, 0.5))
+    a = np.linspace(0.0, 2.0 * math.pi, 37)
+    ring.points = _points(np.column_stack((position[0] + danger_distance * np.cos(a),
+                                           position[1] + danger_distance * np.sin(a))))
+    out.markers.append(ring)
+    return out

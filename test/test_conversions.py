@@ -1,0 +1,58 @@
+"""Message <-> array conversions, with messages built directly (no rclpy.init)."""
+
+import math
+
+from builtin_interfaces.msg import Time
+import numpy as np
+import pytest
+
+from subapf_planner.core.occupancy import OccupancyGrid
+from subapf_planner.ros.conversions import (
+    cmd_from_msg,
+    cmd_to_msg,
+    grid_to_msg,
+    odom_to_msg,
+    path_to_msg,
+    pose_from_odom,
+    scan_from_msg,
+    scan_to_msg,
+    seconds_to_stamp,
+    stamp_to_seconds,
+)
+
+pytestmark = pytest.mark.node
+
+
+def test_grid_message_keeps_geometry_and_maps_log_odds_to_percent():
+    grid = OccupancyGrid(0.1, 2.0)
+    grid.log_odds[3, 5] = 3.5          # occupied
+    grid.log_odds[4, 5] = -2.0         # free
+    msg = grid_to_msg(grid, 'odom', Time(sec=7))
+    assert msg.header.frame_id == 'odom' and msg.header.stamp.sec == 7
+    assert (msg.info.width, msg.info.height) == (20, 20)
+    assert msg.info.resolution == pytest.approx(0.1)
+    assert (msg.info.origin.position.x, msg.info.origin.position.y) == (-1.0, -1.0)
+    data = np.asarray(msg.data).reshape(20, 20)          # row-major, row = y
+    assert data[3, 5] == 97 and data[4, 5] == 12 and data[0, 0] == -1
+    assert (data == -1).sum() == 398
+
+
+def test_path_message_orients_each_pose_along_the_path():
+    pts = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0]])
+    msg = path_to_msg(pts, 'odom', Time())
+    assert [p.header.frame_id for p in msg.poses] == ['odom'] * 3
+    yaw = [2 * math.atan2(p.pose.orientation.z, p.pose.orientation.w) for p in msg.poses]
+    assert yaw[0] == pytest.approx(0.0) and yaw[1] == pytest.approx(math.pi / 2)
+    assert len(path_to_msg(np.zeros((0, 2)), 'odom', Time()).poses) == 0
+
+
+def test_round_trips():
+    assert stamp_to_seconds(seconds_to_stamp(12.345678912)) == pytest.approx(12.345678912)
+    for stamped in (True, False):
+        assert cmd_from_msg(cmd_to_msg(0.1, -0.5, stamped)) == (0.1, -0.5)
+    pose = np.array([1.0, -2.0, 2.5])
+    np.testing.assert_allclose(pose_from_odom(odom_to_msg(pose, (0.0, 0.0), 3.0)), pose)
+    ranges = np.array([1.0, np.inf, np.nan, 0.0])
+    scan = scan_from_msg(scan_to_msg(ranges, -0.1, 0.01, 0.12, 3.5, 4.0, 'base_scan'))
+    np.testing.assert_array_equal(scan.ranges, ranges.astype(np.float32))
+    assert scan.stamp == pytest.approx(4.0) and scan.angle_increment == pytest.approx(0.01)

@@ -1,0 +1,209 @@
+"""Occupancy memory and navigation field (core/occupancy.py, core/navigation.py)."""
+
+import math
+
+from hypothesis import given, settings
+from hypothesis import strategies as st
+import numpy as np
+import pytest
+
+from subapf_planner.core.config import PlannerConfig
+from subapf_planner.core.memory import NavigationMemory
+from subapf_planner.core.navigation import NEIGHBOURS, compute_field
+from subapf_planner.core.occupancy import LOG_ODDS_MAX, OccupancyGrid
+from subapf_planner.core.planner import Planner
+from subapf_planner.core.status import Status
+
+pytestmark = pytest.mark.core
+
+RES = 0.05
+
+
+def one_beam(grid, r, yaw=0.0, origin=(0.0, 0.0)):
+    grid.update([r], 0.0, 0.01, 0.12, 3.5, (origin[0], origin[1], yaw))
+
+
+def test_a_beam_marks_its_end_and_clears_what_it_crossed():
+    grid = OccupancyGrid(RES, 10.0)
+    grid.log_odds[:] = 1.0                     # everything believed occupied
+    one_beam(grid, 2.0)
+    occ = grid.occupied()
+    end = tuple(grid.cell_of([2.0, 0.0])[0])
+    assert occ[end] and grid.log_odds[end] > 1.0
+    for x in np.arange(0.05, 1.9, 0.05):      # crossed cells lost evidence
+        assert grid.log_odds[tuple(grid.cell_of([x, 0.0])[0])] < 1.0, x
+    assert grid.log_odds[tuple(grid.cell_of([2.5, 0.0])[0])] == 1.0   # beyond: untouched
+    assert grid.log_odds[tuple(grid.cell_of([0.0, 1.0])[0])] == 1.0   # off the beam
+
+
+@pytest.mark.parametrize('bad', [math.nan, 0.0, -1.0, 0.05])
+def test_invalid_returns_change_nothing(bad):
+    grid = OccupancyGrid(RES, 10.0)
+    one_beam(grid, bad)
+    assert not grid.log_odds.any()
+
+
+def test_open_beam_clears_up_to_its_range():
+    grid = OccupancyGrid(RES, 10.0)
+    grid.log_odds[:] = 0.5
+    grid.update([math.inf], 0.0, 0.01, 0.12, 3.5, (0.0, 0.0, 0.0), clear_range=2.0)
+    assert grid.log_odds[tuple(grid.cell_of([1.9, 0.0])[0])] < 0.5
+    assert grid.log_odds[tuple(grid.cell_of([2.2, 0.0])[0])] == 0.5
+
+
+def test_an_obstacle_seen_then_seen_through_is_forgotten():
+    grid = OccupancyGrid(RES, 10.0)
+    for _ in range(20):
+        one_beam(grid, 1.0)                   # a thing at 1 m, seen often
+    cell = tuple(grid.cell_of([1.0, 0.0])[0])
+    assert grid.log_odds[cell] == pytest.approx(LOG_ODDS_MAX)
+    scans = 0
+    while grid.occupied()[cell]:
+        one_beam(grid, 3.0)                   # it moved away: the beam now reaches 3 m
+        scans += 1
+    assert scans <= 10
+
+
+def test_memory_stays_bounded_on_a_long_drive():
+    grid = OccupancyGrid(RES, 20.0)
+    size = grid.nbytes
+    ranges = np.full(360, 1.5)
+    for k in range(400):                      # 200 m straight, scanning all the way
+        x = 0.5 * k
+        grid.follow((x, 0.0))
+        grid.update(ranges, 0.0, 2 * math.pi / 360, 0.12, 3.5, (x, 0.0, 0.0))
+        robot = grid.cell_of([x, 0.0])[0]
+        assert grid.inside(robot[None])[0]
+    assert grid.nbytes == size == 400 * 400 * 4
+    # only what is near the robot is remembered
+    assert grid.centre_of(np.argwhere(grid.occupied()))[:, 0].min() > 200.0 - 20.0
+
+
+def test_window_reaches_towards_a_far_goal():
+    grid = OccupancyGrid(RES, 20.0)
+    assert grid.follow((0.0, 0.0), (15.0, 0.0))
+    centre = grid.origin + grid.size / 2
+    assert 5.0 <= centre[0] <= 10.0           # robot and goal both inside
+
+
+# --- the field ------------------------------------------------------------------------
+def field_on(occ, goal, robot=(0.1, 0.1), inflation=0.0, soft=0.0):
+    return compute_field(occ, (0.0, 0.0), RES, goal, robot, inflation, soft)
+
+
+@settings(max_examples=60, deadline=None)
+@given(seed=st.integers(0, 2**31 - 1), fill=st.floats(0.0, 0.35),
+       inflation=st.sampled_from([0.0, 0.06, 0.125]), soft=st.sampled_from([0.0, 0.2]))
+def test_no_local_minimum_but_the_goal(seed, fill, inflation, soft):
+    """Every reachable cell but the goal's has an 8-neighbour with a strictly lower value."""
+    rng = np.random.default_rng(seed)
+    occ = rng.random((40, 40)) < fill
+    free = np.argwhere(~occ)
+    if len(free) == 0:
+        return
+    gr, gc = free[rng.integers(len(free))]
+    f = field_on(occ, ((gc + 0.5) * RES, (gr + 0.5) * RES), ((gc + 0.5) * RES,
+                                                              (gr + 0.5) * RES), inflation, soft)
+    if f is None:                               # goal inside the inflation
+        return
+    v = f.values                                # (the patch the field was computed on)
+    h, w = v.shape
+    padded = np.pad(v, 1, constant_values=np.inf)
+    lowest = np.min([padded[1 + dr:1 + dr + h, 1 + dc:1 + dc + w] for dr, dc in NEIGHBOURS],
+                    axis=0)
+    reachable = np.isfinite(v)
+    reachable[np.unravel_index(np.argmin(np.where(reachable, v, np.inf)), v.shape)] = False
+    assert np.all(lowest[reachable] < v[reachable])
+
+
+def test_field_is_close_to_euclidean_in_open_space_and_agrees_with_differences():
+    occ = np.zeros((200, 200), bool)
+    goal = np.array([5.0, 5.0])
+    f = field_on(occ, goal, robot=(9.0, 9.0))   # the patch: robot, goal and a margin
+    rng = np.random.default_rng(3)
+    pts = rng.uniform(4.5, 8.5, (200, 2))   # inside the patch, off its border
+    pts = pts[np.hypot(*(pts - goal).T) > 0.5]
+    d = np.hypot(*(pts - goal).T)
+    assert np.all(np.abs(f.value(pts) - d) <= 0.02 * d + 2 * RES)   # fast marching: ~Euclid
+    # the descent direction points at the goal, and matches -grad by central differences
+    dirs = f.direction(pts)
+    to_goal = (goal - pts) / d[:, None]
+    # (8-neighbour descent: a few degrees of quantisation)
+    assert np.all(np.sum(dirs * to_goal, axis=1) > math.cos(math.radians(8)))
+    h = 0.02
+    gx = (f.value(pts + [h, 0]) - f.value(pts - [h, 0])) / (2 * h)
+    gy = (f.value(pts + [0, h]) - f.value(pts - [0, h])) / (2 * h)
+    grad = np.column_stack((gx, gy))
+    cos = -np.sum(grad * dirs, axis=1) / np.linalg.norm(grad, axis=1)
+    assert np.all(cos > math.cos(math.radians(8)))
+
+
+def test_the_field_goes_round_a_wall_and_through_a_narrow_gap():
+    occ = np.zeros((100, 100), bool)
+    occ[50, :] = True                            # a wall across y = 2.525 m
+    gap = slice(40, 40 + 6)                      # 6 cells = 0.30 m of free cells
+    occ[50, gap] = False
+    cfg = PlannerConfig()
+    inflation = cfg.inflation_radius
+    f = field_on(occ, (2.0, 4.0), robot=(2.0, 1.0), inflation=inflation,
+                 soft=cfg.inflation_band)
+    assert f is not None
+    start = np.array([4.5, 1.0])
+    assert np.isfinite(f.value(start)[0]) and f.reachable(start)
+    path = f.path(start)
+    crossing = path[np.argmin(np.abs(path[:, 1] - 2.525))]
+    assert 2.0 <= crossing[0] <= 2.3             # through the gap
+    assert np.hypot(*(path[-1] - (2.0, 4.0))) < 2 * RES
+    # closed wall: the other side cannot be reached
+    occ[50, gap] = True
+    f = field_on(occ, (2.0, 4.0), robot=(2.0, 1.0), inflation=inflation)
+    assert not np.isfinite(f.value(start)[0]) and not f.reachable(start)
+    # a gap narrower than twice the inflation radius: the field goes through it (slowly,
+    # so that a robot pushed into it is led on), but the goal counts as unreachable
+    occ[50, 42:45] = False                       # 3 cells = 0.15 m
+    f = field_on(occ, (2.0, 4.0), robot=(2.0, 1.0), inflation=inflation,
+                 soft=cfg.inflation_band)
+    assert np.isfinite(f.value(start)[0]) and not f.reachable(start)
+
+
+def test_goal_in_an_inflated_obstacle_has_no_field():
+    occ = np.zeros((60, 60), bool)
+    occ[30, 30] = True
+    assert field_on(occ, (1.5, 1.525), inflation=0.125) is None
+
+
+def enclosure_scan(radius, n=360):
+    return np.full(n, radius), 0.0, 2 * math.pi / n, 0.12, 3.5
+
+
+def test_planner_stops_for_an_enclosed_goal_and_drives_when_it_opens():
+    planner = Planner(PlannerConfig())
+    pose = np.array([0.0, 0.0, 0.0])
+    ranges, amin, inc, rmin, rmax = enclosure_scan(1.0)
+    ranges = ranges.copy()
+    goal = (2.0, 0.0)                            # outside a closed ring of radius ~1 m
+    for k in range(3):
+        res = planner.step_scan(pose, goal, ranges, amin, inc, rmin, rmax, stamp=k, now=k)
+    assert res.command.status is Status.GOAL_UNREACHABLE and res.command.v == 0.0
+    ranges[-30:] = np.inf                        # an opening appears (and stays)
+    ranges[:30] = np.inf
+    for k in range(3, 12):
+        res = planner.step_scan(pose, goal, ranges, amin, inc, rmin, rmax, stamp=k, now=k)
+    assert res.command.status is not Status.GOAL_UNREACHABLE
+
+
+def test_memory_recomputes_on_a_new_goal_and_at_most_every_field_period():
+    cfg = PlannerConfig(field_period=1.0)
+    mem = NavigationMemory(cfg)
+    ranges, amin, inc, rmin, rmax = enclosure_scan(2.0)
+    mem.integrate(ranges, amin, inc, rmin, rmax, (0.0, 0.0, 0.0), 0.0)
+    mem.field_for((0, 0), (1.0, 0.0), now=0.0)
+    assert mem.recomputed
+    mem.integrate(ranges, amin, inc, rmin, rmax, (0.0, 0.0, 0.0), 0.2)
+    mem.field_for((0, 0), (1.0, 0.0), now=0.2)
+    assert not mem.recomputed                    # grid changed, but within field_period
+    mem.field_for((0, 0), (0.0, 1.0), now=0.4)
+    assert mem.recomputed                        # new goal
+    mem.integrate(ranges, amin, inc, rmin, rmax, (0.0, 0.0, 0.0), 1.5)
+    mem.field_for((0, 0), (0.0, 1.0), now=1.5)
+    assert mem.recomputed
