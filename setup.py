@@ -1,6 +1,8 @@
 """ament_python build of subapf_planner (colcon) that also installs with pip."""
 
 from glob import glob
+import os
+import sys
 
 from setuptools import find_packages, setup
 
@@ -18,7 +20,47 @@ EXECUTABLES = [
     ('tools.record:main', 'record', 'subapf-record'),
     ('tools.replay:main', 'replay', 'subapf-replay'),
     ('tools.soak:main', 'soak', 'subapf-soak'),
+    ('tools.worlds:main', 'worlds', 'subapf-worlds'),
 ]
+
+# Runtime dependencies from PyPI. The ROS 2 packages (rclpy and the message packages)
+# come from ROS in a sourced Jazzy shell (ROS_DISTRO set), where the ros-jazzy-*
+# wheels would install a second rclpy; anywhere else `pip install .` alone must give
+# working commands, so it brings the wheels (requirements.txt pins the same ones).
+# colcon never installs install_requires; its dependencies are package.xml's.
+ROS_WHEELS = ['ros-jazzy-rclpy[fastrtps]==7.1.6', 'ros-jazzy-common-interfaces==5.3.6']
+INSTALL_REQUIRES = [
+    'numpy>=1.26,<3',
+    'scipy>=1.11',
+    'pybullet==3.2.7',
+    'mcap>=1.2,<2',
+    'matplotlib>=3.8',
+    'pyyaml>=6',
+    'tqdm>=4.66',
+    'scikit-fmm>=2024.5',
+]
+
+# Which names the console scripts get. The bare names (planner_node, bench, perf, ...)
+# are what `ros2 run subapf_planner <exe>` looks for in <prefix>/lib/subapf_planner;
+# on a venv's PATH they would clash with other programs (`perf` is the Linux
+# profiler), so a pip install only gets the subapf-* names.
+#
+# colcon's ament_python build (colcon-core's PythonBuildTask, seen in a real
+# `colcon build`) runs this file directly, as
+#   setup.py egg_info ... build ... install ... --install-scripts $base/lib/subapf_planner
+# or, with --symlink-install, as
+#   setup.py develop --editable ... --no-deps symlink_data
+# whereas pip builds through the PEP 517/660 backend (setuptools.build_meta, see
+# pyproject.toml [build-system]), which runs `setup.py egg_info`, `dist_info`,
+# `bdist_wheel` or `editable_wheel`, never `install` or `develop`. So the command
+# line tells the two apart. (colcon also sets COLCON=1 in the environment, but every
+# process under `colcon test` inherits that too, a pip wheel build included.)
+COLCON_COMMANDS = {'install', 'develop'}
+ROS_BUILD = bool(COLCON_COMMANDS & set(sys.argv[1:]))
+
+console_scripts = [f'{alias} = {PACKAGE}.{target}' for target, _, alias in EXECUTABLES]
+if ROS_BUILD:
+    console_scripts += [f'{name} = {PACKAGE}.{target}' for target, name, _ in EXECUTABLES]
 
 setup(
     name=PACKAGE,
@@ -31,15 +73,12 @@ setup(
         ('share/' + PACKAGE + '/config', glob('config/*.yaml')),
         ('share/' + PACKAGE + '/worlds', glob('sim/worlds/*.yaml')),
     ],
-    install_requires=['setuptools'],
+    install_requires=INSTALL_REQUIRES + ([] if os.environ.get('ROS_DISTRO') else ROS_WHEELS),
     zip_safe=True,
     maintainer='subapf developers',
     maintainer_email='dev@subapf.invalid',
     description='Subharmonic APF local planner with circular sampling, for ROS 2 Jazzy',
     license='Apache-2.0',
     python_requires='>=3.10',
-    entry_points={
-        'console_scripts': [f'{name} = {PACKAGE}.{target}' for target, name, _ in EXECUTABLES]
-        + [f'{alias} = {PACKAGE}.{target}' for target, _, alias in EXECUTABLES],
-    },
+    entry_points={'console_scripts': console_scripts},
 )

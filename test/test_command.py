@@ -41,7 +41,8 @@ def test_slowdown_near_goal():
 
 
 def test_forward_corridor_blocks_only_ahead():
-    ahead = np.array([[0.2, 0.05]])
+    ahead = np.array([[0.15, 0.05]])        # within safety_distance (0.18 m) of the centre
+    assert not forward_blocked((0, 0, 0), np.array([[0.2, 0.05]]), CFG)   # beyond it
     beside = np.array([[0.0, 0.2]])
     behind = np.array([[-0.15, 0.0]])
     assert forward_blocked((0, 0, 0), ahead, CFG)

@@ -1,7 +1,6 @@
 """Faults: lost and late scans in the loop, and input streams that stop and resume."""
 
 import math
-import os
 import time
 
 from conftest import WORLDS
@@ -57,7 +56,6 @@ def test_scan_delivery_loses_and_delays_as_configured():
 
 @pytest.fixture
 def node_and_clock():
-    os.environ['ROS_DOMAIN_ID'] = str(100 - os.getpid() % 30)
     context = rclpy.Context()
     rclpy.init(context=context)
     node = PlannerNode(context=context, parameter_overrides=[

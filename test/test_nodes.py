@@ -18,6 +18,8 @@ from subapf_planner.ros.conversions import odom_to_msg, scan_to_msg
 from subapf_planner.ros.planner_node import PlannerNode
 from subapf_planner.ros.qos import LATCHED as LATCHED_QOS
 
+pytestmark = pytest.mark.node
+
 
 @pytest.fixture
 def ros():
@@ -179,8 +181,6 @@ SPIN_SCRIPT = """
 import sys
 from rclpy.node import Node
 from subapf_planner.ros.spinning import spin_node
-
-pytestmark = pytest.mark.node
 
 class Crashing(Node):
     def __init__(self):

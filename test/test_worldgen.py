@@ -1,4 +1,5 @@
-"""Procedural worlds (sim/worldgen.py) and ``subapf-worlds`` (tools/worlds.py)."""
+"""Procedural worlds (sim/worldgen.py, sim/solvability.py) and ``subapf-worlds``
+(tools/worlds.py)."""
 
 import math
 import re
@@ -7,7 +8,7 @@ import pytest
 import yaml
 
 from subapf_planner.core.config import PlannerConfig
-from subapf_planner.sim import worldgen
+from subapf_planner.sim import solvability, worldgen
 from subapf_planner.sim.episode import run_episode
 from subapf_planner.sim.world import Box, load_world, parse_world, world_files
 from subapf_planner.tools.worlds import main
@@ -66,8 +67,8 @@ def test_every_family_parses_and_is_solvable(family):
         assert world.start[:2] == (0.0, 0.0)
         for x, y in (world.start[:2], world.goal):
             assert world.clearance(x, y) >= worldgen.ENDPOINT_CLEARANCE
-        assert worldgen.is_solvable(world)
-        length = worldgen.geodesic_length(world)
+        assert solvability.is_solvable(world)
+        length = solvability.geodesic_length(world)
         assert length == pytest.approx(g.geodesic_length)
         assert length >= math.dist(world.start[:2], world.goal) - 0.1
         assert world.time_limit == math.ceil(60 + 4 * length / 0.22)
@@ -79,14 +80,14 @@ def test_every_family_parses_and_is_solvable(family):
 def test_solvability_check_rejects_closed_and_too_narrow_walls():
     closed = walled(0.0)
     closed['obstacles'] = [{'box': {'center': [2.0, 1.5], 'size': [0.1, 3.0]}}]
-    assert not worldgen.is_solvable(closed)
-    assert worldgen.geodesic_length(closed) == math.inf
-    assert not worldgen.is_solvable(walled(0.28))       # < 2 x 0.155 m
-    assert worldgen.is_solvable(walled(0.45))
-    assert worldgen.geodesic_length(walled(0.45)) == pytest.approx(3.0, abs=0.1)
-    assert worldgen.bottleneck_width(walled(0.45)) == pytest.approx(0.45, abs=0.03)
+    assert not solvability.is_solvable(closed)
+    assert solvability.geodesic_length(closed) == math.inf
+    assert not solvability.is_solvable(walled(0.28))       # < 2 x 0.155 m
+    assert solvability.is_solvable(walled(0.45))
+    assert solvability.geodesic_length(walled(0.45)) == pytest.approx(3.0, abs=0.1)
+    assert solvability.bottleneck_width(walled(0.45)) == pytest.approx(0.45, abs=0.03)
     # the robot itself (0.105 m) would pass 0.28 m: the check keeps the margin
-    assert worldgen.is_solvable(walled(0.28), radius=0.105)
+    assert solvability.is_solvable(walled(0.28), radius=0.105)
 
 
 def test_doorway_width_from_geometry():
@@ -96,16 +97,16 @@ def test_doorway_width_from_geometry():
         assert isinstance(a, Box) and isinstance(b, Box) and a.yaw == b.yaw == 0.0
         width = box_gap(a, b)
         assert 0.35 - 1e-6 <= width <= 0.8 + 1e-6
-        assert worldgen.bottleneck_width(world) == pytest.approx(width, abs=0.03)
+        assert solvability.bottleneck_width(world) == pytest.approx(width, abs=0.03)
 
 
 def test_zigzag_corridor_width_from_geometry():
     for seed in range(6):
         world = parse_world(worldgen.generate('zigzag', seed))
-        width = worldgen.bottleneck_width(world)   # one width per world
+        width = solvability.bottleneck_width(world)   # one width per world
         assert 0.5 - 0.03 <= width <= 1.0 + 1e-6
         # walls close the corridor: no straight way and a longer geodesic
-        assert worldgen.geodesic_length(world) > math.dist(world.start[:2], world.goal) + 0.5
+        assert solvability.geodesic_length(world) > math.dist(world.start[:2], world.goal) + 0.5
 
 
 @pytest.mark.parametrize('family', ['u_trap', 'c_trap'])

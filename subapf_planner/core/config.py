@@ -120,14 +120,14 @@ class PlannerConfig:
     dwa_clearance: float = param(0.135, 'DWA: arcs passing closer than this to an obstacle '
                                  'point are inadmissible (robot_radius + 0.03 m)', 'm',
                                  0.0, 2.0)
-    dwa_horizon: float = param(1.5, 'DWA rollout horizon', 's', 0.2, 10.0)
+    dwa_horizon: float = param(2.0, 'DWA rollout horizon', 's', 0.2, 10.0)
     dwa_v_samples: int = param(7, 'DWA linear velocity samples', '', 2, 50)
     dwa_w_samples: int = param(15, 'DWA angular velocity samples', '', 3, 101)
-    dwa_heading_weight: float = param(0.8, 'DWA weight of the goal-heading term', '',
-                                       0.0, 100.0)
-    dwa_clearance_weight: float = param(0.2, 'DWA weight of the clearance term', '',
+    dwa_heading_weight: float = param(0.2, 'DWA weight of the goal term (weights tuned once '
+                                      'on the dev suite, README)', '', 0.0, 100.0)
+    dwa_clearance_weight: float = param(0.6, 'DWA weight of the clearance term', '',
                                          0.0, 100.0)
-    dwa_velocity_weight: float = param(0.1, 'DWA weight of the forward-speed term', '',
+    dwa_velocity_weight: float = param(0.4, 'DWA weight of the forward-speed term', '',
                                         0.0, 100.0)
 
     def __post_init__(self) -> None:
@@ -143,8 +143,9 @@ class PlannerConfig:
 
     @property
     def geodesic(self) -> bool:
-        """The navigation-function attraction is on (never for DWA)."""
-        return self.attraction_field == 'geodesic' and self.method != 'dwa'
+        """The navigation-function attraction is on (for DWA: its goal term, as the global
+        dynamic window of Brock and Khatib 1999)."""
+        return self.attraction_field == 'geodesic'
 
     @property
     def discard_distance(self) -> float:

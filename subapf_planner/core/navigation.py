@@ -40,6 +40,8 @@ CROP_MARGIN = 1.0
 #: The 8 neighbours (d_row, d_col) and their lengths in cells.
 NEIGHBOURS = np.array([(-1, -1), (-1, 0), (-1, 1), (0, -1), (0, 1), (1, -1), (1, 0), (1, 1)])
 NEIGHBOUR_LENGTH = np.hypot(NEIGHBOURS[:, 0], NEIGHBOURS[:, 1])
+#: Unit vectors (x, y) towards the 8 neighbours (x along columns, y along rows).
+NEIGHBOUR_UNIT = NEIGHBOURS[:, ::-1] / NEIGHBOUR_LENGTH[:, None]
 
 
 @dataclass(frozen=True)
@@ -47,17 +49,16 @@ class NavigationField:
     """Distance to ``goal`` [m] on a grid patch, inf where blocked or cut off.
 
     ``origin`` is the odom corner of cell (0, 0); rows are y, columns x.
-    ``descent`` (rows, cols, 2) is the unit direction of steepest descent in odom
-    (x, y), zero where there is none (blocked cells, the goal).
     """
 
     origin: NDArray[np.float64]
     resolution: float
     values: NDArray[np.float64]
-    descent: NDArray[np.float64]
     goal: NDArray[np.float64]
     #: Cells (rows, cols) connected to the goal through the hard-inflated free space.
     passable: NDArray[np.bool_]
+    #: ``values`` with a border of inf cells (neighbour look-ups need no bounds checks).
+    padded: NDArray[np.float64]
 
     def reachable(self, point: ArrayLike, radius_cells: int = 3) -> bool:
         """Whether the goal can be reached from ``point`` (a cell within ``radius_cells``
@@ -97,13 +98,27 @@ class NavigationField:
         with np.errstate(invalid='ignore', divide='ignore'):
             return np.where(wsum > 1e-9, num / np.maximum(wsum, 1e-12), np.inf)
 
+    def descent(self, rows: NDArray[np.int64], cols: NDArray[np.int64]) -> NDArray[np.float64]:
+        """Unit steepest-descent direction (..., 2) as (x, y) at cells (rows, cols) of the
+        patch: the sum of the unit vectors to the 8 neighbours weighted by how much lower
+        each is per metre; cut-off (inf) cells have none and count for none (zero)."""
+        padded = self.padded
+        v = padded[rows + 1, cols + 1]
+        v = np.where(np.isfinite(v), v, -np.inf)    # a cut-off cell descends nowhere
+        nb = padded[rows[..., None] + 1 + NEIGHBOURS[:, 0], cols[..., None] + 1 + NEIGHBOURS[:, 1]]
+        drop = v[..., None] - nb                     # -inf towards or from cut-off cells
+        slope = np.where(drop > 0.0, drop, 0.0) / NEIGHBOUR_LENGTH
+        acc = slope @ NEIGHBOUR_UNIT
+        norm = np.sqrt(acc[..., 0] ** 2 + acc[..., 1] ** 2)[..., None]
+        return np.where(norm > 1e-12, acc / np.maximum(norm, 1e-12), 0.0)
+
     def direction(self, points: ArrayLike) -> NDArray[np.float64]:
         """Unit descent direction at each point (n, 2); where the point's corners have
         none (inside an inflated obstacle), the direction to the nearest cell that has
         one, within a few cells; zero when there is none either."""
         p = np.atleast_2d(np.asarray(points, float))
         rows, cols, w = self._corners(p)
-        d = np.sum(self.descent[rows, cols] * w[..., None], axis=1)
+        d = np.sum(self.descent(rows, cols) * w[..., None], axis=1)
         norm = np.linalg.norm(d, axis=1)
         out = np.where(norm[:, None] > 1e-9, d / np.maximum(norm, 1e-12)[:, None], 0.0)
         for i in np.flatnonzero(norm <= 1e-9):
@@ -150,24 +165,6 @@ class NavigationField:
             cells.append(nb[k])
         rc = np.asarray(cells, float)
         return self.origin + (rc[:, ::-1] + 0.5) * self.resolution
-
-
-def descent_directions(values: NDArray[np.float64]) -> NDArray[np.float64]:
-    """Unit steepest-descent direction per cell (rows, cols, 2) as (x, y): the sum of the
-    unit vectors to the 8 neighbours weighted by how much lower each is per metre;
-    blocked (inf) neighbours never count."""
-    h, w = values.shape
-    padded = np.pad(values, 1, constant_values=np.inf)
-    acc = np.zeros((h, w, 2))
-    with np.errstate(invalid='ignore'):
-        for (dr, dc), length in zip(NEIGHBOURS, NEIGHBOUR_LENGTH, strict=True):
-            nb = padded[1 + dr:1 + dr + h, 1 + dc:1 + dc + w]
-            drop = np.where(np.isfinite(values) & np.isfinite(nb), values - nb, 0.0)
-            slope = np.maximum(drop, 0.0) / length
-            acc[..., 0] += slope * dc / length
-            acc[..., 1] += slope * dr / length
-    norm = np.linalg.norm(acc, axis=2, keepdims=True)
-    return np.where(norm > 1e-12, acc / np.maximum(norm, 1e-12), 0.0)
 
 
 def crop_box(occupied: NDArray[np.bool_], cells: NDArray[np.int64],
@@ -224,5 +221,5 @@ def compute_field(occupied: NDArray[np.bool_], origin: ArrayLike, resolution: fl
     goal_used = g if (0 <= (g - origin)[0] < w * resolution
                       and 0 <= (g - origin)[1] < h * resolution) \
         else origin + (gc[::-1] + 0.5) * resolution
-    return NavigationField(patch_origin, resolution, values, descent_directions(values),
-                           goal_used, passable)
+    return NavigationField(patch_origin, resolution, values, goal_used, passable,
+                           np.pad(values, 1, constant_values=np.inf))

@@ -80,7 +80,7 @@ def plan(cfg: PlannerConfig, pose: ArrayLike, goal: ArrayLike, obstacles: ArrayL
     if goal_distance > cfg.goal_tolerance and float(clearance(goal, obs)[0]) < cfg.robot_radius:
         return PlanResult(Command(0.0, 0.0, Status.GOAL_IN_OBSTACLE), **common)
     if cfg.method == 'dwa':
-        return _plan_dwa(cfg, pose, goal, obs, previous, common)
+        return _plan_dwa(cfg, pose, goal, obs, previous, common, field)
     repulsors = voxel_downsample(obs, cfg.voxel_size)
     raw = apf_step(position, goal, repulsors, cfg, field)[0]
     sampling = None
@@ -93,16 +93,18 @@ def plan(cfg: PlannerConfig, pose: ArrayLike, goal: ArrayLike, obstacles: ArrayL
 
 
 def _plan_dwa(cfg: PlannerConfig, pose: NDArray, goal: NDArray, obs: NDArray,
-              previous: tuple[float, float], common: dict) -> PlanResult:
+              previous: tuple[float, float], common: dict,
+              field: NavigationField | None) -> PlanResult:
     if common['goal_distance'] <= cfg.goal_tolerance:
         return PlanResult(Command(0.0, 0.0, Status.REACHED), **common)
-    res = dwa_command(pose, goal, previous, voxel_downsample(obs, cfg.voxel_size), cfg)
+    res = dwa_command(pose, goal, previous, voxel_downsample(obs, cfg.voxel_size), cfg, field)
     if not res.admissible:
         return PlanResult(Command(0.0, 0.0, Status.NO_SAFE_MOVE), **common)
     v, status = res.v, Status.DRIVING if res.v > 0.0 else Status.TURNING
     if v > 0.0 and forward_blocked(pose, obs, cfg):
         v, status = 0.0, Status.BLOCKED_AHEAD
-    return PlanResult(Command(v, res.w, status), None, res.trajectory[-1].copy(), **common)
+    return PlanResult(Command(v, res.w, status), None, res.trajectory[-1].copy(), field=field,
+                      **common)
 
 
 class Planner:

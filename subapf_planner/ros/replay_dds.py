@@ -1,12 +1,15 @@
 """Replay a bag through the real ``planner_node`` over DDS, in lockstep with /clock.
 
 The node runs as a child process on a private, localhost-only domain with
-``use_sim_time``. A player publishes the recorded ``odom``, ``scan`` and
-``goal_pose`` of each simulated instant, then that instant on ``/clock``; where
-the bag has a ``cmd_vel`` stamped at that instant, the player waits for the
-node's own ``cmd_vel`` with the same stamp before going on. So the replay runs
-as fast as the node answers, and its commands can be compared one by one with
-the recorded ones and with the in-process replay (replay.py).
+``use_sim_time`` and ``enable_stamped_cmd_vel`` matching the bag's cmd_vel type. A
+player publishes the recorded ``odom``, ``scan`` and ``goal_pose`` of each
+simulated instant of the bag's event stream (bag/events.py, which the in-process
+replay reads too), then that instant on ``/clock``; where the bag has a ``cmd_vel``
+at that instant, the player waits for the node's own ``cmd_vel`` for it before
+going on: a TwistStamped carries its tick's stamp, a Twist is taken as the answer
+to the ``/clock`` instant at which it arrives. So the replay runs as fast as the
+node answers, and its commands can be compared one by one with the recorded ones
+and with the in-process replay (tools/replay.py).
 """
 
 from __future__ import annotations
@@ -15,7 +18,8 @@ from pathlib import Path
 import subprocess
 import time
 
-from geometry_msgs.msg import PoseStamped, TwistStamped
+from builtin_interfaces.msg import Time
+from geometry_msgs.msg import PoseStamped, Twist, TwistStamped
 from nav_msgs.msg import Odometry
 import numpy as np
 import rclpy
@@ -25,55 +29,60 @@ from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import LaserScan
 from std_msgs.msg import String
 
-from ..bag.reader import BagError, read
-from ..tools.replay import Comparison, check_topics
-from .conversions import cmd_from_msg, seconds_to_stamp, stamp_to_seconds
+from ..bag.comparison import Comparison
+from ..bag.events import STAMPED_CMD, Event, check_topics, events, stamp_ns
+from ..bag.reader import BagError
+from .conversions import cmd_from_msg
 from .processes import join_domain, start, stop
 
 #: Longest wait for the node's answer to one tick [s].
 ANSWER_TIMEOUT = 5.0
 #: Wall-clock pause around the first tick, so the goal and first inputs are delivered [s].
 FIRST_TICK_PAUSE = 0.2
+#: The first /clock is set this much before the first tick, so the inputs are fresh [ns].
+FIRST_CLOCK_LEAD = 50_000_000
+#: Wall-clock pause between the inputs of a tick's instant and its /clock, so they
+#: reach the node before the clock makes it tick: DDS does not order messages across
+#: topics, and the scan is best effort (never acknowledged) [s].
+INPUT_SETTLE = 0.01
 
 
-def _instants(path: str, names: dict[str, str]) -> list[tuple[float, list, list]]:
-    """[(t, inputs [(role, msg)], recorded commands [(v, w)])] in simulated time order,
-    from the first recorded command on."""
-    role = {topic: r for r, topic in names.items()}
-    inputs: dict[float, list] = {}
-    cmds: dict[float, list] = {}
-    now = 0.0
-    for m in read(path, set(names.values())):
-        r = role[m.topic]
-        if r in ('scan', 'odom'):
-            now = max(now, stamp_to_seconds(m.message.header.stamp))
-            inputs.setdefault(stamp_to_seconds(m.message.header.stamp), []).append(
-                (r, m.message))
-        elif r == 'goal':
-            inputs.setdefault(now, []).append((r, m.message))
-        else:
-            cmds.setdefault(stamp_to_seconds(m.message.header.stamp), []).append(
-                cmd_from_msg(m.message))
-    times = sorted(set(inputs) | set(cmds))
-    if not cmds:
+def _time(ns: int) -> Time:
+    return Time(sec=ns // 1_000_000_000, nanosec=ns % 1_000_000_000)
+
+
+def _instants(stream: list[Event]) -> list[tuple[int, list[Event], list[Event]]]:
+    """[(t [ns], inputs, recorded commands)] from the bag's events, one per simulated
+    time, from the first recorded command on."""
+    cmd_times = [e.time_ns for e in stream if e.role == 'cmd_vel']
+    if not cmd_times:
         return []
     # Before its first command the recorded node only collected inputs (and may have
-    # missed some while discovery settled): hand them all over, then tick at t0.
-    t0 = min(cmds)
-    early = [item for t in times if t <= t0 for item in inputs.get(t, [])]
-    goals = [item for item in early if item[0] == 'goal']
-    early = goals[-1:] + [item for item in early if item[0] != 'goal']
-    return [(t0, early, cmds[t0])] + [(t, inputs.get(t, []), cmds.get(t, []))
-                                      for t in times if t > t0]
+    # missed some while discovery settled): hand them all over, the newest goal
+    # first, then tick at t0.
+    t0 = cmd_times[0]
+    early = [e for e in stream if e.time_ns <= t0 and e.role != 'cmd_vel']
+    goals = [e for e in early if e.role == 'goal']
+    first = (t0, goals[-1:] + [e for e in early if e.role != 'goal'],
+             [e for e in stream if e.time_ns == t0 and e.role == 'cmd_vel'])
+    instants = [first]
+    for e in stream:
+        if e.time_ns <= t0:
+            continue
+        if instants[-1][0] != e.time_ns:
+            instants.append((e.time_ns, [], []))
+        instants[-1][2 if e.role == 'cmd_vel' else 1].append(e)
+    return instants
 
 
 def replay_through_node(path: str, params: str, names: dict[str, str],
                         method: str | None = None, domain: int = 90) -> Comparison:
     """Run the bag through a planner_node process; see the module docstring."""
-    check_topics(path, names)
-    instants = _instants(path, names)
+    stamped = check_topics(path, names) == STAMPED_CMD
+    instants = _instants(events(path, names))
     env = join_domain(domain)
-    ros_args = ['--params-file', str(Path(params).resolve()), '-p', 'use_sim_time:=true']
+    ros_args = ['--params-file', str(Path(params).resolve()), '-p', 'use_sim_time:=true',
+                '-p', f'enable_stamped_cmd_vel:={str(stamped).lower()}']
     if method:
         ros_args += ['-p', f'method:={method}']
     child = start('planner_node', ros_args, env, quiet=True)
@@ -81,7 +90,7 @@ def replay_through_node(path: str, params: str, names: dict[str, str],
     rclpy.init(context=context)
     node = Node('subapf_replay_player', context=context)
     try:
-        return _play(node, context, child, instants, names)
+        return _play(node, context, child, instants, names, stamped)
     finally:
         node.destroy_node()
         rclpy.try_shutdown(context=context)
@@ -97,12 +106,18 @@ def _pause(executor, seconds: float) -> None:
 
 
 def _play(node: Node, context, child: subprocess.Popen, instants: list,
-          names: dict[str, str]) -> Comparison:
+          names: dict[str, str], stamped: bool) -> Comparison:
     executor = rclpy.executors.SingleThreadedExecutor(context=context)
     executor.add_node(node)
-    answers: dict[float, tuple[float, float]] = {}
-    node.create_subscription(TwistStamped, names['cmd_vel'], lambda m: answers.__setitem__(
-        stamp_to_seconds(m.header.stamp), cmd_from_msg(m)), 100)
+    answers: dict[int, tuple[float, float]] = {}   # tick [ns] -> (v, w)
+    clock_now = [0]   # the last /clock published [ns]: a Twist answers that tick
+
+    def on_cmd(msg) -> None:
+        t = stamp_ns(msg.header.stamp) if stamped else clock_now[0]
+        answers.setdefault(t, cmd_from_msg(msg))
+
+    node.create_subscription(TwistStamped if stamped else Twist, names['cmd_vel'], on_cmd,
+                             100)
     statuses: list[str] = []
     node.create_subscription(String, '/subapf_planner/status', lambda m: statuses.append(m.data),
                              100)
@@ -110,6 +125,11 @@ def _play(node: Node, context, child: subprocess.Popen, instants: list,
             'odom': node.create_publisher(Odometry, names['odom'], 10),
             'goal': node.create_publisher(PoseStamped, names['goal'], 10)}
     clock = node.create_publisher(Clock, '/clock', 10)
+
+    def publish_clock(ns: int) -> None:
+        clock_now[0] = ns
+        clock.publish(Clock(clock=_time(ns)))
+
     deadline = time.monotonic() + 30.0
     while not all(p.get_subscription_count() > 0 for p in (*pubs.values(), clock)) or \
             node.count_publishers(names['cmd_vel']) == 0:
@@ -122,23 +142,25 @@ def _play(node: Node, context, child: subprocess.Popen, instants: list,
         if i == 0:
             # Set the node's clock to just before the first tick, so the inputs are fresh,
             # and repeat until its timer has run once (the first /clock may be lost while
-            # discovery completes on the node's side).
+            # discovery completes on the node's side). No goal yet: no command.
             end = time.monotonic() + 30.0
             while not statuses and time.monotonic() < end and child.poll() is None:
-                clock.publish(Clock(clock=seconds_to_stamp(max(0.0, t - 0.05))))
+                publish_clock(max(0, t - FIRST_CLOCK_LEAD))
                 _pause(executor, 0.05)
-        for r, msg in inputs:
-            pubs[r].publish(msg)
-        _pause(executor, FIRST_TICK_PAUSE if i == 0 else 0.0)
-        clock.publish(Clock(clock=seconds_to_stamp(t)))
+            answers.clear()
+        for e in inputs:
+            pubs[e.role].publish(e.message)
+        settle = INPUT_SETTLE if inputs and cmds else 0.0
+        _pause(executor, FIRST_TICK_PAUSE if i == 0 else settle)
+        publish_clock(t)
         if not cmds:
             continue
         end = time.monotonic() + ANSWER_TIMEOUT
         while t not in answers and time.monotonic() < end and child.poll() is None:
             executor.spin_once(timeout_sec=0.01)
-        for v_w in cmds:
-            times.append(t)
-            recorded.append(v_w)
+        for e in cmds:
+            times.append(e.time)
+            recorded.append(cmd_from_msg(e.message))
             replayed.append(answers.get(t, (np.nan, np.nan)))
     return Comparison(np.asarray(times), np.asarray(recorded, float).reshape(-1, 2),
                       np.asarray(replayed, float).reshape(-1, 2))

@@ -41,6 +41,8 @@ RECORDED = {
     '/subapf_planner/plan': (Path, _RELIABLE),
     '/subapf_planner/map': (OccupancyGrid, _LATCHED_DEEP),
 }
+#: Longest the recorder drains its queues on close [s].
+DRAIN_TIMEOUT = 5.0
 #: Recorded only when asked for by name (--record-topics): the map is 160 kB a message.
 ON_REQUEST = {'/subapf_planner/map'}
 
@@ -56,6 +58,7 @@ class Supervisor:
         self.method = method
         self.node = Node('subapf_bringup')
         self.recorder = McapRecorder(record) if record else None
+        self._written = 0   # messages recorded (close drains until none come)
         self.path: list = []
         self.sim_time = 0.0
         self.outcome: str | None = None
@@ -77,6 +80,7 @@ class Supervisor:
     def _recording(self, topic: str):
         def write(data: bytes) -> None:
             self.recorder.write(topic, data, time.time_ns())
+            self._written += 1
         return write
 
     def _on_outcome(self, msg: String) -> None:
@@ -128,9 +132,15 @@ class Supervisor:
 
     def close(self) -> None:
         if self.recorder is not None:
-            # drain what is already queued, then finalise the file
-            for _ in range(10):
+            # drain what is already queued (the nodes are stopped: nothing new comes; what
+            # they sent last, e.g. the planner's zero velocity, was acknowledged, so it is
+            # here), at most DRAIN_TIMEOUT, then finalise the file
+            deadline = time.monotonic() + DRAIN_TIMEOUT
+            idle = 0
+            while idle < 5 and time.monotonic() < deadline:
+                before = self._written
                 rclpy.spin_once(self.node, timeout_sec=0.01)
+                idle = idle + 1 if self._written == before else 0
             self.recorder.close()
         self.node.destroy_node()
         rclpy.try_shutdown()

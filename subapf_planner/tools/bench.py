@@ -32,10 +32,11 @@ from .paths import default_params_file, shipped_worlds_dir
 from .plots import plot_trajectories
 
 #: The default comparison: the package's default, the paper's method and its ablations
-#: (Euclidean attraction, eq. 21), and the DWA baseline.
+#: (Euclidean attraction, eq. 21), and the DWA baseline, classic and on the same field
+#: (Brock and Khatib's global dynamic window).
 DEFAULT_METHODS = ('subharmonic_sampling:geodesic', 'subharmonic_sampling:euclidean',
                    'subharmonic:euclidean', 'traditional:euclidean', 'harmonic:euclidean',
-                   'dwa')
+                   'dwa:euclidean', 'dwa:geodesic')
 FIELDS = ('geodesic', 'euclidean')
 
 
@@ -43,9 +44,9 @@ def parse_method(spec: str) -> dict:
     """``method[:attraction_field]`` -> config changes; ValueError when unknown. Without a
     field the configuration's attraction_field applies."""
     name, _, field = spec.strip().partition(':')
-    if name not in METHODS or (field and field not in FIELDS) or (name == 'dwa' and field):
-        raise ValueError(f'unknown method {spec!r}: use one of {", ".join(METHODS)}, APF '
-                         f'ones optionally with :{"/:".join(FIELDS)}')
+    if name not in METHODS or (field and field not in FIELDS):
+        raise ValueError(f'unknown method {spec!r}: use one of {", ".join(METHODS)}, '
+                         f'optionally with :{" or :".join(FIELDS)}')
     changes = {'method': name}
     if field:
         changes['attraction_field'] = field
@@ -59,8 +60,7 @@ def _run_world(job: tuple) -> list[tuple[dict, list]]:
     out = []
     for spec in methods:
         run_cfg = cfg.replace(**parse_method(spec))
-        label = 'dwa' if run_cfg.method == 'dwa' else \
-            f'{run_cfg.method}:{run_cfg.attraction_field}'
+        label = f'{run_cfg.method}:{run_cfg.attraction_field}'
         result = run_episode(world, run_cfg, sim_cfg, faults=faults, label=label)
         out.append((result.metrics(world), result.path[:, :2].round(4).tolist()))
     if plot_dir is not None:

@@ -1,27 +1,31 @@
 """``subapf-replay``: feed a recorded run through the planner and compare its cmd_vel.
 
 The recorded ``scan``, ``odom`` and ``goal_pose`` go through the same
-``PlannerController`` the node runs, in recorded order and simulated time (as
-fast as possible); at each recorded ``cmd_vel`` stamp the controller ticks,
-as the node's timer did. Prints count, max and mean |dv| and |dw| and the
-first divergence; exit 0 when max |dv| and |dw| are within ``--tolerance``,
-1 when not, 2 for an unusable bag or parameters.
+``PlannerController`` the node runs, in simulated time order (as fast as possible;
+the event stream of bag/events.py, which the DDS replay reads too); at each
+recorded ``cmd_vel`` the controller ticks, as the node's timer did: at its stamp
+(TwistStamped) or, for a Twist bag, at the simulated time it was recorded at.
+Prints count, max and mean |dv| and |dw| and the first divergence; exit 0 when
+max |dv| and |dw| are within ``--tolerance``, 1 when not, 2 for an unusable bag or
+parameters.
 """
 
 from __future__ import annotations
 
 import argparse
-from dataclasses import dataclass
 import math
 import random
 import sys
 
 import numpy as np
 
-from ..bag.reader import BagError, read, topics
+from ..bag.comparison import Comparison
+from ..bag.events import STAMPED_CMD, events
+from ..bag.reader import BagError
 from ..bag.writer import McapRecorder
 from ..core.config import METHODS, ConfigError, PlannerConfig, load_config, load_params_file
 from ..core.controller import PlannerController, Supervision
+from ..core.params import build
 from ..ros.conversions import (
     cmd_from_msg,
     cmd_to_msg,
@@ -31,95 +35,38 @@ from ..ros.conversions import (
 )
 from .paths import default_params_file
 
-INPUTS = {'scan': 'sensor_msgs/msg/LaserScan', 'odom': 'nav_msgs/msg/Odometry',
-          'goal': 'geometry_msgs/msg/PoseStamped'}
-CMD_TYPES = ('geometry_msgs/msg/TwistStamped', 'geometry_msgs/msg/Twist')
-
-
-@dataclass(frozen=True)
-class Comparison:
-    """Recorded vs replayed commands: times [s], (v, w) arrays (n, 2), NaN = none.
-
-    ``skipped`` leading commands were published before the bag holds a scan, an
-    odometry message and a goal (the recording started after the node did):
-    they cannot be replayed and are left out of the comparison.
-    """
-
-    times: np.ndarray
-    recorded: np.ndarray
-    replayed: np.ndarray
-    skipped: int = 0
-
-    @property
-    def diff(self) -> np.ndarray:
-        d = np.abs(self.replayed - self.recorded)
-        d = np.where(np.isnan(d), np.inf, d)
-        d[:self.skipped] = 0.0
-        return d
-
-    def first_divergence(self, tol_v: float, tol_w: float) -> float | None:
-        bad = (self.diff[:, 0] > tol_v) | (self.diff[:, 1] > tol_w)
-        return float(self.times[np.argmax(bad)]) if np.any(bad) else None
-
-
-def check_topics(path: str, names: dict[str, str]) -> None:
-    """BagError naming what is missing or of the wrong type."""
-    found = topics(path)
-    for role, topic in names.items():
-        want = CMD_TYPES if role == 'cmd_vel' else (INPUTS[role],)
-        if topic not in found:
-            raise BagError(f'{path}: no {topic} topic ({role}); topics: '
-                           f'{", ".join(sorted(found)) or "none"}')
-        if found[topic] not in want:
-            raise BagError(f'{path}: {topic} is {found[topic]}, expected {" or ".join(want)}')
-
 
 def replay(path: str, cfg: PlannerConfig, limits: Supervision,
            names: dict[str, str]) -> Comparison:
-    """Run the controller over the bag; see the module docstring."""
-    check_topics(path, names)
-    role = {topic: r for r, topic in names.items()}
-    events = []   # (sim time, order, role, payload)
-    sim_now = 0.0
-    for m in read(path, set(names.values())):
-        r = role[m.topic]
-        if r == 'scan':
-            scan = scan_from_msg(m.message)
-            sim_now = max(sim_now, scan.stamp)
-            events.append((scan.stamp, 0, r, scan))
-        elif r == 'odom':
-            t = stamp_to_seconds(m.message.header.stamp)
-            sim_now = max(sim_now, t)
-            events.append((t, 0, r, (t, pose_from_odom(m.message))))
-        elif r == 'goal':
-            p = m.message.pose.position
-            events.append((sim_now, 1, r, np.array([p.x, p.y], float)))
-        else:
-            t = stamp_to_seconds(m.message.header.stamp) if hasattr(m.message, 'header') \
-                else sim_now
-            events.append((t, 2, r, cmd_from_msg(m.message)))
-    events.sort(key=lambda e: (e[0], e[1]))
+    """Run the controller over the bag's events (bag/events.py); see the module
+    docstring. Arguments to the controller as planner_node passes them: odometry with
+    its stamp, every input with the time it is handled at."""
     ctl = PlannerController(cfg, limits)
     times, recorded, replayed = [], [], []
     skipped = 0
-    for t, _, r, payload in events:
-        if r == 'scan':
-            ctl.update_scan(payload, t)
-        elif r == 'odom':
-            if np.all(np.isfinite(payload[1])):
-                ctl.update_odom(payload[0], payload[1], t)
-        elif r == 'goal':
-            if np.all(np.isfinite(payload)):
-                ctl.set_goal(payload)
+    for e in events(path, names):
+        t = e.time
+        if e.role == 'scan':
+            ctl.update_scan(scan_from_msg(e.message), t)
+        elif e.role == 'odom':
+            pose = pose_from_odom(e.message)
+            if np.all(np.isfinite(pose)):
+                ctl.update_odom(stamp_to_seconds(e.message.header.stamp), pose, t)
+        elif e.role == 'goal':
+            p = e.message.pose.position
+            goal = np.array([p.x, p.y], float)
+            if np.all(np.isfinite(goal)):
+                ctl.set_goal(goal)
         else:
+            command = cmd_from_msg(e.message)
             leading = skipped == len(replayed) and (ctl.scan is None or ctl.pose is None
                                                     or ctl.goal is None)
             decision = ctl.tick(t)
             if leading:
                 skipped += 1
-                ctl.planner.previous = payload   # the node's state after what it published
+                ctl.planner.previous = command   # the node's state after what it published
             times.append(t)
-            recorded.append(payload)
+            recorded.append(command)
             replayed.append(decision.command if decision.command is not None
                             else (math.nan, math.nan))
     return Comparison(np.asarray(times), np.asarray(recorded, float).reshape(-1, 2),
@@ -133,7 +80,7 @@ def write_commands(out: str, comparison: Comparison) -> None:
     from ..ros.conversions import seconds_to_stamp
     rec = McapRecorder(out)
     try:
-        rec.add_topic('/cmd_vel', CMD_TYPES[0])
+        rec.add_topic('/cmd_vel', STAMPED_CMD)
         for t, (v, w) in zip(comparison.times, comparison.replayed, strict=True):
             if np.isfinite(v):
                 msg = cmd_to_msg(v, w, True, seconds_to_stamp(t))
@@ -162,9 +109,7 @@ def main(argv: list[str] | None = None) -> int:
     try:
         params = args.params or default_params_file()
         cfg = load_config(params, method=args.method)
-        node = load_params_file(params)
-        limits = Supervision(**{k: float(node.get(k, getattr(Supervision(), k)))
-                                for k in Supervision.__dataclass_fields__})
+        limits = build(Supervision, load_params_file(params), ignore_unknown=True)
         names = {'scan': args.scan_topic, 'odom': args.odom_topic, 'goal': args.goal_topic,
                  'cmd_vel': args.cmd_topic}
         if args.through_node:

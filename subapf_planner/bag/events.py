@@ -1,0 +1,130 @@
+"""A recorded run as one time-ordered stream of planner inputs and commands.
+
+Both replays (in-process, tools/replay.py, and through a planner_node over DDS,
+ros/replay_dds.py) read a bag through :func:`events`, so they see the same
+events at the same simulated times in the same order:
+
+* ``scan`` and ``odom`` at their header stamps;
+* ``goal`` (PoseStamped; RViz and the bringup leave its stamp at zero) at the
+  newest simulated time seen before it in the bag;
+* ``cmd_vel`` at its header stamp when it is a TwistStamped (the node stamps each
+  command with its planning tick), and for a Twist, which has no stamp, at the
+  newest simulated time seen before it: the tick it answered.
+
+"Newest simulated time seen" is the largest scan or odometry stamp, or ``/clock``
+value when the bag has that topic, among the messages logged before. Events are
+sorted by time; at equal times inputs come first, then goals, then commands (the
+node ticks after what it has received), each kind in log order.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from .reader import BagError, read, topics
+
+#: Message type of each input role.
+INPUT_TYPES = {'scan': 'sensor_msgs/msg/LaserScan', 'odom': 'nav_msgs/msg/Odometry',
+               'goal': 'geometry_msgs/msg/PoseStamped'}
+STAMPED_CMD = 'geometry_msgs/msg/TwistStamped'
+PLAIN_CMD = 'geometry_msgs/msg/Twist'
+#: Accepted cmd_vel types (the node's enable_stamped_cmd_vel true / false).
+CMD_TYPES = (STAMPED_CMD, PLAIN_CMD)
+ROLES = ('scan', 'odom', 'goal', 'cmd_vel')
+CLOCK_TOPIC = '/clock'
+CLOCK_TYPE = 'rosgraph_msgs/msg/Clock'
+#: Order among events at the same time.
+_RANK = {'scan': 0, 'odom': 0, 'goal': 1, 'cmd_vel': 2}
+
+
+@dataclass(frozen=True)
+class Event:
+    """One recorded message with the simulated time it belongs to [ns]."""
+
+    time_ns: int
+    role: str
+    message: Any
+
+    @property
+    def time(self) -> float:
+        """[s], as a node's clock gives it (nanoseconds * 1e-9)."""
+        return self.time_ns * 1e-9
+
+
+def stamp_ns(stamp: Any) -> int:
+    """A builtin_interfaces/Time as integer nanoseconds (exact)."""
+    return int(stamp.sec) * 1_000_000_000 + int(stamp.nanosec)
+
+
+def check_topics(path: str | Path, names: dict[str, str]) -> str:
+    """BagError naming what is missing or of the wrong type; else the bag's cmd_vel
+    type name (one of CMD_TYPES).
+
+    ``names`` maps each role of ROLES to its topic in the bag.
+    """
+    found = topics(path)
+    for role in ROLES:
+        topic = names[role]
+        want = CMD_TYPES if role == 'cmd_vel' else (INPUT_TYPES[role],)
+        if topic not in found:
+            raise BagError(f'{path}: no {topic} topic ({role}); topics: '
+                           f'{", ".join(sorted(found)) or "none"}')
+        if found[topic] not in want:
+            raise BagError(f'{path}: {topic} is {found[topic]}, expected {" or ".join(want)}')
+    return found[names['cmd_vel']]
+
+
+def events(path: str | Path, names: dict[str, str]) -> list[Event]:
+    """The bag's scan, odom, goal and cmd_vel messages as time-ordered events (see the
+    module docstring). Checks the topics first (check_topics)."""
+    check_topics(path, names)
+    role = {topic: r for r, topic in names.items() if r in ROLES}
+    wanted = set(role)
+    if topics(path).get(CLOCK_TOPIC) == CLOCK_TYPE and CLOCK_TOPIC not in wanted:
+        wanted.add(CLOCK_TOPIC)
+    out: list[tuple[int, int, int, Event]] = []
+    now = 0
+    for i, m in enumerate(read(path, wanted)):
+        r = role.get(m.topic)
+        if r is None:   # /clock: only a time source
+            now = max(now, stamp_ns(m.message.clock))
+            continue
+        if r in ('scan', 'odom'):
+            t = stamp_ns(m.message.header.stamp)
+            now = max(now, t)
+        elif r == 'cmd_vel' and m.type_name == STAMPED_CMD:
+            t = stamp_ns(m.message.header.stamp)
+        else:   # goal, Twist command
+            t = now
+        out.append((t, _RANK[r], i, Event(t, r, m.message)))
+    out = _snap_plain_commands(out)
+    out.sort(key=lambda e: e[:3])
+    return [e[3] for e in out]
+
+
+def _snap_plain_commands(out: list[tuple[int, int, int, Event]]) -> list:
+    """Twist commands come from a periodic timer, but the newest clock before one may
+    already be the next instant when the node took long to plan: put each on the
+    latest tick of the timer's grid at or before it (period: the median spacing of the
+    commands; phase: the most common remainder)."""
+    plain = [k for k, e in enumerate(out)
+             if e[3].role == 'cmd_vel' and not hasattr(e[3].message, 'header')]
+    if len(plain) < 3:
+        return out
+    times = np.array([out[k][0] for k in plain], dtype=np.int64)
+    steps = np.diff(times)
+    period = int(np.median(steps[steps > 0])) if np.any(steps > 0) else 0
+    if period <= 0:
+        return out
+    rest, counts = np.unique(times % period, return_counts=True)
+    phase = int(rest[np.argmax(counts)])
+    snapped = phase + (times - phase) // period * period
+    out = list(out)
+    for k, t in zip(plain, snapped.tolist(), strict=True):
+        _, rank, i, e = out[k]
+        out[k] = (t, rank, i, Event(t, e.role, e.message))
+    return out

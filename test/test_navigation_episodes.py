@@ -1,0 +1,65 @@
+"""Closed-loop episodes on generated worlds: the geodesic default gets out of what traps
+the paper's method (the progress checker gives the goal up), with the same parameters."""
+
+import pytest
+
+from subapf_planner.core.config import PlannerConfig
+from subapf_planner.core.status import Outcome
+from subapf_planner.sim.episode import run_episode
+from subapf_planner.sim.world import parse_world
+from subapf_planner.sim.worldgen import generate, sub_seed
+
+pytestmark = pytest.mark.sim
+
+#: The dev suite's seed (README "World suites"); worlds named as subapf-worlds names them.
+DEV_SEED = 2026
+PAPER = PlannerConfig(attraction_field='euclidean')
+
+
+def dev_world(family: str, index: int):
+    name = f'{family}_{index:03d}'
+    return parse_world(generate(family, sub_seed(DEV_SEED, family, index), name), name)
+
+
+@pytest.mark.parametrize('family,index', [('u_trap', 23), ('doorway', 2), ('zigzag', 4),
+                                          ('maze', 3)])
+def test_default_reaches_what_the_paper_method_abandons(family, index):
+    world = dev_world(family, index)
+    default = run_episode(world, PlannerConfig())
+    assert default.outcome is Outcome.REACHED
+    assert default.statuses.get('goal_unreachable', 0) == 0
+    paper = run_episode(world, PAPER)
+    assert paper.outcome is Outcome.ABANDONED       # as it is: stalled, then given up
+    assert paper.final_distance > 1.0
+
+
+def test_a_goal_walled_in_stops_with_goal_unreachable():
+    """Unknown space counts as free, so the robot first drives round the box; once it
+    has seen every side it stops, with goal_unreachable, and stays stopped."""
+    doc = {'name': 'walled', 'start': [0.0, 0.0, 0.0], 'goal': [2.0, 0.0], 'time_limit': 60,
+           'obstacles': [{'box': {'center': [2.0, 0.6], 'size': [1.4, 0.1]}},
+                         {'box': {'center': [2.0, -0.6], 'size': [1.4, 0.1]}},
+                         {'box': {'center': [1.35, 0.0], 'size': [0.1, 1.3]}},
+                         {'box': {'center': [2.65, 0.0], 'size': [0.1, 1.3]}}]}
+    result = run_episode(parse_world(doc), PlannerConfig())
+    assert result.outcome is Outcome.TIMEOUT                 # never abandoned, never inside
+    stopped = result.statuses.get('goal_unreachable', 0)
+    assert stopped >= 50                                     # the last 10 s at least
+    moved = result.path[-stopped:, :2] - result.path[-1, :2]
+    assert abs(moved).max() < 0.05                           # standing still meanwhile
+
+
+@pytest.mark.parametrize('offset', [0.0, 0.7])
+def test_a_gap_of_twice_robot_radius_plus_5_cm_is_passed(offset):
+    """2 x (0.105 + 0.05) = 0.31 m between two wall ends, straight ahead or off the line;
+    the paper's method (samples discarded within d0 = 0.25 m) cannot pass it."""
+    gap = 0.31
+    left, right = offset - gap / 2, offset + gap / 2
+    doc = {'name': 'gap', 'start': [0.0, 0.0, 1.5708], 'goal': [0.0, 3.0], 'time_limit': 90,
+           'bounds': [-2.5, -1.0, 2.5, 4.0],
+           'obstacles': [{'box': {'center': [(left - 2.5) / 2, 1.5], 'size': [left + 2.5, 0.1]}},
+                         {'box': {'center': [(right + 2.5) / 2, 1.5],
+                                  'size': [2.5 - right, 0.1]}}]}
+    world = parse_world(doc)
+    assert run_episode(world, PlannerConfig()).outcome is Outcome.REACHED
+    assert run_episode(world, PAPER).outcome is not Outcome.REACHED
