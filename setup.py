@@ -70,7 +70,7 @@ setup(
     data_files=[
         ('share/ament_index/resource_index/packages', ['resource/' + PACKAGE]),
         ('share/' + PACKAGE, ['package.xml']),
-        ('share/' + PACKAGE + '/config', glob('config/*.yaml')),
+        ('share/' + PACKAGE + '/config', glob('config/*.yaml') + glob('config/*.xml')),
         ('share/' + PACKAGE + '/worlds', glob('sim/worlds/*.yaml')),
     ],
     install_requires=INSTALL_REQUIRES + ([] if os.environ.get('ROS_DISTRO') else ROS_WHEELS),

@@ -22,10 +22,13 @@ def test_short_bench_writes_consistent_results(tmp_path, worlds_dir):
     out = tmp_path / 'out'
     worlds = [str(worlds_dir / 'four_points.yaml'),
               str(worlds_dir / 'fig6c_circle_in_front.yaml')]
-    rc = main(worlds + ['--methods', 'subharmonic_sampling,dwa', '--out', str(out)])
+    rc = main(worlds + ['--methods', 'subharmonic_sampling,dwa:euclidean', '--out', str(out)])
     assert rc == 0
-    runs = json.loads((out / 'results.json').read_text())['runs']
+    doc = json.loads((out / 'results.json').read_text())
+    runs = doc['runs']
     assert len(runs) == 4
+    # the attraction field is part of each method's name (the params file's by default)
+    assert doc['methods'] == ['subharmonic_sampling:geodesic', 'dwa:euclidean']
     for r in runs:
         assert KEYS <= set(r)
         assert r['outcome'] in ('reached', 'collision', 'timeout', 'abandoned')
@@ -42,6 +45,8 @@ def test_short_bench_writes_consistent_results(tmp_path, worlds_dir):
 
 def test_bench_rejects_unknown_method_and_bad_world(tmp_path, capsys):
     assert main(['--methods', 'magic', '--out', str(tmp_path)]) == 2
+    assert 'unknown method' in capsys.readouterr().err
+    assert main(['--methods', 'dwa:straight', '--out', str(tmp_path)]) == 2
     assert 'unknown method' in capsys.readouterr().err
     bad = tmp_path / 'bad.yaml'
     bad.write_text('name: x\n')

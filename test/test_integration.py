@@ -86,7 +86,13 @@ def test_bad_world_and_bad_parameters_exit_with_clear_errors(tmp_path, ros_env):
 
 
 def test_standalone_recorder_finalises_on_sigint_and_replays(tmp_path, bringup_env):
+    """Run with the paper's memoryless method: with the default's occupancy memory a
+    replay is exact only when the live node got every scan before its tick, which a
+    loaded machine at 5x does not give (README, "Recording and replay")."""
     env = bringup_env
+    paper = tmp_path / 'paper.yaml'
+    paper.write_text(PARAMS.read_text().replace('attraction_field: geodesic',
+                                                'attraction_field: euclidean'))
     bag = tmp_path / 'rec.mcap'
     rec = subprocess.Popen([sys.executable, '-m', 'subapf_planner.tools.record', '--topics',
                             '/scan', '/odom', '/cmd_vel', '/goal_pose', '/clock', '-o', str(bag)],
@@ -95,7 +101,7 @@ def test_standalone_recorder_finalises_on_sigint_and_replays(tmp_path, bringup_e
         log = subscribe_recorder_first(rec)
         # the bringup records the run too: the reference the recorder is measured by
         result = bringup(tmp_path, 'fig6c_circle_in_front.yaml', env, '--record',
-                         str(tmp_path / 'ref.mcap'))
+                         str(tmp_path / 'ref.mcap'), '--params', str(paper))
         assert result.returncode == 0, result.stdout + result.stderr
     finally:
         rec.send_signal(signal.SIGINT)
@@ -104,8 +110,8 @@ def test_standalone_recorder_finalises_on_sigint_and_replays(tmp_path, bringup_e
     assert 'messages in' in out
     check_bag_with_rosbags(bag, outcome=False)
     r = subprocess.run([sys.executable, '-m', 'subapf_planner.tools.replay', str(bag),
-                        '--tolerance', '1e-9'], capture_output=True, text=True, timeout=120,
-                       env=env)
+                        '--tolerance', '1e-9', '--params', str(paper)], capture_output=True,
+                       text=True, timeout=120, env=env)
     assert r.returncode in (0, 1), r.stdout + r.stderr
     total = int(r.stdout.split('commands compared: ')[1].split()[0])
     # How many commands a run has depends on the load (a busy planner skips ticks of
@@ -115,7 +121,10 @@ def test_standalone_recorder_finalises_on_sigint_and_replays(tmp_path, bringup_e
     # of driving (10 commands: 2 s of simulated time; an idle run has about 90)
     commands = {name: cmd_vel_count(tmp_path / name) for name in ('rec.mcap', 'ref.mcap')}
     assert commands['rec.mcap'] >= commands['ref.mcap'], commands
-    assert total >= 10 and '(replay silent on 0;' in r.stdout, r.stdout
+    silent = int(r.stdout.split('replay silent on ')[1].split(';')[0])
+    # silent at most on the zero the planner published on shutdown, after the goal was
+    # reached: no planning tick answers it
+    assert total >= 10 and silent <= 1, r.stdout
     # A recorder in another process sees the inputs in its own order, not always in the
     # node's (DDS orders messages per topic, not across topics): nearly all commands
     # must still be reproduced exactly. (Bags from the bringup replay exactly:

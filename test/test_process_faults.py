@@ -1,7 +1,10 @@
 """Process faults over real DDS: simulator restarted mid-run, planner killed mid-run."""
 
+import os
+from pathlib import Path
 import signal
 import time
+import xml.etree.ElementTree as ET
 
 from conftest import PARAMS, WORLDS
 from geometry_msgs.msg import TwistStamped
@@ -12,7 +15,13 @@ from rclpy.executors import SingleThreadedExecutor
 from std_msgs.msg import String
 
 from subapf_planner.ros.conversions import stamp_to_seconds
-from subapf_planner.ros.processes import join_domain, start, stop
+from subapf_planner.ros.processes import (
+    PROFILE_VARS,
+    join_domain,
+    start,
+    stop,
+    use_package_profile,
+)
 from subapf_planner.ros.sim_node import LATCHED
 
 pytestmark = pytest.mark.dds
@@ -185,3 +194,21 @@ def test_simulator_sigkilled_and_restarted_at_once_planner_resumes_every_time(gr
             graph.logs()
         assert graph.planner.poll() is None    # the same planner process throughout
     print(f'restart -> driving [s] (bound {bound:.1f}): ' + ' '.join(f'{t:.1f}' for t in took))
+
+
+def test_package_fastdds_profile_is_used_unless_the_user_chose_one(monkeypatch):
+    for var in PROFILE_VARS:
+        monkeypatch.delenv(var, raising=False)
+    path = use_package_profile()
+    assert Path(path).name == 'fastdds.xml' and os.environ[PROFILE_VARS[0]] == path
+    ns = '{http://www.eprosima.com/XMLSchemas/fastRTPS_Profiles}'
+    root = ET.parse(path).getroot()
+    period = root.find(f'.//{ns}data_writer/{ns}times/{ns}heartbeatPeriod')
+    assert int(period.find(f'{ns}sec').text) == 0
+    assert int(period.find(f'{ns}nanosec').text) == 100_000_000
+    lease = root.find(f'.//{ns}participant//{ns}leaseDuration')
+    assert int(lease.find(f'{ns}sec').text) == 5
+    monkeypatch.delenv(PROFILE_VARS[0])
+    monkeypatch.setenv(PROFILE_VARS[1], '/elsewhere/mine.xml')
+    assert use_package_profile() == '/elsewhere/mine.xml'
+    assert PROFILE_VARS[0] not in os.environ

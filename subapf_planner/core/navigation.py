@@ -26,6 +26,7 @@ Units: values in metres of free-space travel (seconds at 1 m/s).
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 import math
 
 import numpy as np
@@ -144,26 +145,36 @@ class NavigationField:
         n = float(np.hypot(*v))
         return v / n if n > 1e-9 else np.zeros(2)
 
+    @cached_property
+    def downhill(self) -> NDArray[np.int64]:
+        """Per cell (flat index), the flat index of its lowest 8-neighbour when that is
+        strictly lower, else -1 (the goal, cut-off cells). Computed once per field."""
+        h, w = self.values.shape
+        p = self.padded
+        nb = np.stack([p[1 + dr:1 + dr + h, 1 + dc:1 + dc + w] for dr, dc in NEIGHBOURS])
+        k = np.argmin(nb, axis=0)
+        lower = np.take_along_axis(nb, k[None], axis=0)[0] < self.values
+        rows, cols = np.indices((h, w))
+        target = (rows + NEIGHBOURS[k, 0]) * w + cols + NEIGHBOURS[k, 1]
+        return np.where(lower, target, -1).ravel()
+
     def path(self, start: ArrayLike, max_length: float = 30.0) -> NDArray[np.float64]:
         """Steepest-descent polyline (k, 2) [m] from ``start`` along the grid (each step to
         the lowest 8-neighbour) until the goal cell or ``max_length``; empty when the
-        start has no finite value nearby."""
-        h, wd = self.values.shape
+        start is off the patch or cut off from the goal."""
+        h, w = self.values.shape
         p = np.asarray(start, float)[:2]
         c = np.floor((p - self.origin) / self.resolution).astype(int)[::-1]   # (row, col)
-        if not (0 <= c[0] < h and 0 <= c[1] < wd) or not np.isfinite(self.values[c[0], c[1]]):
+        if not (0 <= c[0] < h and 0 <= c[1] < w) or not np.isfinite(self.values[c[0], c[1]]):
             return np.zeros((0, 2))
-        cells = [c]
+        downhill = self.downhill
+        cells = [int(c[0]) * w + int(c[1])]
         for _ in range(int(max_length / self.resolution)):
-            nb = cells[-1] + NEIGHBOURS
-            ok = (nb[:, 0] >= 0) & (nb[:, 0] < h) & (nb[:, 1] >= 0) & (nb[:, 1] < wd)
-            vals = np.full(8, np.inf)
-            vals[ok] = self.values[nb[ok, 0], nb[ok, 1]]
-            k = int(np.argmin(vals))
-            if not vals[k] < self.values[cells[-1][0], cells[-1][1]]:
+            nxt = int(downhill[cells[-1]])
+            if nxt < 0:
                 break
-            cells.append(nb[k])
-        rc = np.asarray(cells, float)
+            cells.append(nxt)
+        rc = np.column_stack(np.divmod(np.asarray(cells), w)).astype(float)
         return self.origin + (rc[:, ::-1] + 0.5) * self.resolution
 
 

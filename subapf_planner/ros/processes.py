@@ -9,14 +9,38 @@ import subprocess
 import sys
 import time
 
+from .paths import fastdds_profile_file
+
 CHILD_STOP_TIMEOUT = 5.0
+#: The environment variables Fast DDS reads its XML profiles file from (2.x, 3.x).
+PROFILE_VARS = ('FASTRTPS_DEFAULT_PROFILES_FILE', 'FASTDDS_DEFAULT_PROFILES_FILE')
+#: The package's Fast DDS profile, relative to share/subapf_planner or the checkout.
+
+
+def use_package_profile() -> str | None:
+    """Make this process (and the children it starts with os.environ) load the package's
+    Fast DDS profile, config/fastdds.xml, unless the user chose a profiles file
+    (FASTRTPS_DEFAULT_PROFILES_FILE or FASTDDS_DEFAULT_PROFILES_FILE set, even empty).
+    Call it before the process's first rclpy node: Fast DDS reads the file once.
+    Returns the profiles file in use, or None."""
+    for var in PROFILE_VARS:
+        if var in os.environ:
+            return os.environ[var] or None
+    try:
+        path = str(fastdds_profile_file())
+    except FileNotFoundError:
+        return None
+    os.environ['FASTRTPS_DEFAULT_PROFILES_FILE'] = path
+    return path
 
 
 def join_domain(domain_id: int) -> dict[str, str]:
-    """Put this process on DDS over loopback in its own domain (set before its rclpy
-    init), and return the environment for the child processes that share the domain."""
+    """Put this process on DDS over loopback in its own domain with the package's Fast
+    DDS profile (set before its rclpy init), and return the environment for the child
+    processes that share the domain."""
     os.environ['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
     os.environ['ROS_DOMAIN_ID'] = str(domain_id)
+    use_package_profile()
     return dict(os.environ, PYTHONUNBUFFERED='1')
 
 

@@ -24,11 +24,11 @@ import numpy as np
 from tqdm import tqdm
 
 from ..core.config import METHODS, ConfigError, load_config
+from ..ros.paths import default_params_file, shipped_worlds_dir
 from ..sim.episode import run_episode
 from ..sim.faults import ScanFaults
 from ..sim.simulator import SimConfig
 from ..sim.world import WorldError, load_world, world_files
-from .paths import default_params_file, shipped_worlds_dir
 from .plots import plot_trajectories
 
 #: The default comparison: the package's default, the paper's method and its ablations

@@ -19,10 +19,10 @@ import sys
 import numpy as np
 
 from ..core.config import METHODS, load_config
+from ..ros.paths import default_params_file
 from ..ros.processes import join_domain, start, stop
 from ..sim.metrics import path_length
 from ..sim.world import World, WorldError, load_world
-from .paths import default_params_file
 
 
 def parse_args(argv: list[str] | None) -> argparse.Namespace:
@@ -85,7 +85,11 @@ def run_once(world: World, world_path: str, params: str, domain: int, *,
     except KeyboardInterrupt:   # before the supervisor took over the signals
         outcome = 'interrupted'
     finally:
-        stop(children)
+        # the planner first: its zero velocity, acknowledged by the simulator's reliable
+        # cmd_vel subscription before the planner exits (ros/spinning.py), stops the
+        # robot; then the simulator
+        for child in reversed(children):
+            stop([child])
         if sup is not None:
             sup.close()
     if sup is None:

@@ -23,8 +23,8 @@ import numpy as np  # noqa: E402
 from ..core.apf import apf_step  # noqa: E402
 from ..core.config import PlannerConfig, load_config  # noqa: E402
 from ..core.potentials import repulsive_dr, repulsive_field  # noqa: E402
+from ..ros.paths import default_params_file, shipped_worlds_dir  # noqa: E402
 from ..sim.world import World, load_world, obstacle_outline  # noqa: E402
-from .paths import default_params_file, shipped_worlds_dir  # noqa: E402
 from .plots import METHOD_STYLE, draw_world  # noqa: E402
 
 FOUR_POINTS = np.array([[1.0, 1.0], [-1.0, -1.0], [-1.0, 1.0], [1.0, -1.0]])

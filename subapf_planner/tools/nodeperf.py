@@ -23,8 +23,8 @@ import time
 import numpy as np
 
 from ..ros.conversions import stamp_to_seconds
+from ..ros.paths import default_params_file, shipped_worlds_dir
 from ..ros.processes import join_domain, rss_mib, start, stop
-from .paths import default_params_file, shipped_worlds_dir
 
 
 def proc_cpu_seconds(pid: int) -> float:

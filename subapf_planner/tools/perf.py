@@ -17,10 +17,10 @@ import time
 import numpy as np
 
 from ..core.config import METHODS, load_config
+from ..ros.paths import default_params_file, shipped_worlds_dir
 from ..sim.episode import run_episode
 from ..sim.simulator import SimConfig
 from ..sim.world import load_world, world_files
-from .paths import default_params_file, shipped_worlds_dir
 
 #: Bytes per field cell: values (float64), descent (2 x float64), passable (bool).
 FIELD_BYTES_PER_CELL = 8 + 16 + 1

@@ -33,7 +33,7 @@ from ..ros.conversions import (
     scan_from_msg,
     stamp_to_seconds,
 )
-from .paths import default_params_file
+from ..ros.paths import default_params_file
 
 
 def replay(path: str, cfg: PlannerConfig, limits: Supervision,

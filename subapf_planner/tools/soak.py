@@ -19,9 +19,9 @@ import random
 import sys
 import time
 
+from ..ros.paths import default_params_file, shipped_worlds_dir
 from ..sim.world import load_world, world_files
 from .bringup import run_once
-from .paths import default_params_file, shipped_worlds_dir
 
 ERROR_MARKERS = ('[ERROR]', '[FATAL]', 'Traceback')
 #: Memory samples (one a second) skipped at the start of each run.

@@ -1,4 +1,4 @@
-"""Where the package's shipped files are: worlds and the parameter files.
+"""Where the package's shipped files are: worlds, the parameter file, the DDS profile.
 
 Looked up in this order: the ament index (colcon workspace or the pip
 install's share/ folder), then the source checkout this module lives in.
@@ -41,3 +41,8 @@ def shipped_worlds_dir() -> Path:
 def default_params_file() -> Path:
     """The package's config/planner.yaml."""
     return _find('config/planner.yaml')
+
+
+def fastdds_profile_file() -> Path:
+    """The package's Fast DDS profile, config/fastdds.xml (see ros/processes.py)."""
+    return _find('config/fastdds.xml')
