@@ -109,11 +109,9 @@ def test_standalone_recorder_finalises_on_sigint_and_replays(tmp_path, bringup_e
     assert rec.returncode == 0, log + err
     assert 'messages in' in out
     check_bag_with_rosbags(bag, outcome=False)
-    r = subprocess.run([sys.executable, '-m', 'subapf_planner.tools.replay', str(bag),
-                        '--tolerance', '1e-9', '--params', str(paper)], capture_output=True,
-                       text=True, timeout=120, env=env)
-    assert r.returncode in (0, 1), r.stdout + r.stderr
-    total = int(r.stdout.split('commands compared: ')[1].split()[0])
+    replays = {name: replay_summary(tmp_path / name, paper, env)
+               for name in ('rec.mcap', 'ref.mcap')}
+    total, silent, within = replays['rec.mcap']
     # How many commands a run has depends on the load (a busy planner skips ticks of
     # simulated time), so the recorder is measured by the bringup's own bag of the
     # same run: it subscribed before the run (the bringup's recorder only once the
@@ -121,16 +119,27 @@ def test_standalone_recorder_finalises_on_sigint_and_replays(tmp_path, bringup_e
     # of driving (10 commands: 2 s of simulated time; an idle run has about 90)
     commands = {name: cmd_vel_count(tmp_path / name) for name in ('rec.mcap', 'ref.mcap')}
     assert commands['rec.mcap'] >= commands['ref.mcap'], commands
-    silent = int(r.stdout.split('replay silent on ')[1].split(';')[0])
     # silent at most on the zero the planner published on shutdown, after the goal was
     # reached: no planning tick answers it
-    assert total >= 10 and silent <= 1, r.stdout
+    assert total >= 10 and silent <= 1, replays
     # A recorder in another process sees the inputs in its own order, not always in the
-    # node's (DDS orders messages per topic, not across topics): nearly all commands
-    # must still be reproduced exactly. (Bags from the bringup replay exactly:
-    # test_replay.py.)
+    # node's (DDS orders messages per topic, not across topics), and a loaded machine
+    # makes that worse: the standalone recorder's bag must replay about as faithfully
+    # as the bringup's own recording of the same run (idle: 99 of 99 for both).
+    ref_total, _, ref_within = replays['ref.mcap']
+    assert within / total >= ref_within / ref_total - 0.1 and within >= 0.75 * total, replays
+
+
+def replay_summary(bag: Path, params: Path, env: dict[str, str]) -> tuple[int, int, int]:
+    """(commands compared, replay silent on, within 1e-9) of subapf-replay on ``bag``."""
+    r = subprocess.run([sys.executable, '-m', 'subapf_planner.tools.replay', str(bag),
+                        '--tolerance', '1e-9', '--params', str(params)], capture_output=True,
+                       text=True, timeout=120, env=env)
+    assert r.returncode in (0, 1), r.stdout + r.stderr
+    total = int(r.stdout.split('commands compared: ')[1].split()[0])
+    silent = int(r.stdout.split('replay silent on ')[1].split(';')[0])
     within = int(r.stdout.split('within tolerance: ')[1].split()[0])
-    assert within >= 0.9 * total, r.stdout
+    return total, silent, within
 
 
 def cmd_vel_count(bag: Path) -> int:
