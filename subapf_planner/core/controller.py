@@ -18,6 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .config import PlannerConfig
+from .memory import SAME_GOAL
 from .params import check_fields, param
 from .planner import Planner, PlanResult
 from .status import State, Status
@@ -26,8 +27,6 @@ from .status import State, Status
 POSE_HISTORY = 100
 #: A scan is placed with the odometry pose nearest its stamp, if within this [s].
 POSE_MATCH = 0.1
-#: Goals closer than this to the current one are the same goal [m].
-SAME_GOAL = 1e-3
 
 
 @dataclass(frozen=True)

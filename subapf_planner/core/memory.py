@@ -17,7 +17,7 @@ from .config import PlannerConfig
 from .navigation import NavigationField, compute_field
 from .occupancy import OccupancyGrid
 
-#: Goals closer than this to the one the field was computed for are the same [m].
+#: Goals closer than this are the same goal (the field's, the controller's) [m].
 SAME_GOAL = 1e-3
 
 
