@@ -199,11 +199,14 @@ def test_memory_recomputes_on_a_new_goal_and_at_most_every_field_period():
     mem.integrate(ranges, amin, inc, rmin, rmax, (0.0, 0.0, 0.0), 0.0)
     mem.field_for((0, 0), (1.0, 0.0), now=0.0)
     assert mem.recomputed
-    mem.integrate(ranges, amin, inc, rmin, rmax, (0.0, 0.0, 0.0), 0.2)
+    mem.integrate(*enclosure_scan(1.5), (0.0, 0.0, 0.0), 0.2)
     mem.field_for((0, 0), (1.0, 0.0), now=0.2)
     assert not mem.recomputed                    # grid changed, but within field_period
     mem.field_for((0, 0), (0.0, 1.0), now=0.4)
     assert mem.recomputed                        # new goal
-    mem.integrate(ranges, amin, inc, rmin, rmax, (0.0, 0.0, 0.0), 1.5)
+    mem.integrate(*enclosure_scan(1.2), (0.0, 0.0, 0.0), 1.5)
     mem.field_for((0, 0), (0.0, 1.0), now=1.5)
-    assert mem.recomputed
+    assert mem.recomputed                        # grid changed, field_period over
+    mem.integrate(*enclosure_scan(1.2), (0.0, 0.0, 0.0), 3.0)
+    mem.field_for((0, 0), (0.0, 1.0), now=3.0)
+    assert not mem.recomputed                    # the same walls seen again: no change

@@ -90,7 +90,8 @@ class NavigationMemory:
             return self.field
         cfg = self.cfg
         self.field = compute_field(self.grid.occupied(), self.grid.origin, self.grid.resolution,
-                                   g, p, cfg.inflation_radius, cfg.inflation_band)
+                                   g, p, cfg.inflation_radius, cfg.inflation_band,
+                                   cfg.field_coarsening)
         self._field_key = key
         self._field_time = -math.inf if now is None else now
         self.recomputed = True

@@ -43,6 +43,12 @@ NEIGHBOURS = np.array([(-1, -1), (-1, 0), (-1, 1), (0, -1), (0, 1), (1, -1), (1,
 NEIGHBOUR_LENGTH = np.hypot(NEIGHBOURS[:, 0], NEIGHBOURS[:, 1])
 #: Unit vectors (x, y) towards the 8 neighbours (x along columns, y along rows).
 NEIGHBOUR_UNIT = NEIGHBOURS[:, ::-1] / NEIGHBOUR_LENGTH[:, None]
+#: Border of inf cells around a field's values: the bilinear corners of any point, and
+#: their neighbours, index the padded array with no bounds checks.
+PAD = 3
+#: Bilinear corners (col + 0|1, row + 0|1), in the order of the weights.
+_CORNER_RIGHT = np.array([False, True, False, True])
+_CORNER_UP = np.array([False, False, True, True])
 
 
 @dataclass(frozen=True)
@@ -56,71 +62,80 @@ class NavigationField:
     resolution: float
     values: NDArray[np.float64]
     goal: NDArray[np.float64]
-    #: Cells (rows, cols) connected to the goal through the hard-inflated free space.
+    #: Cells (rows, cols) connected to the goal through the hard-inflated free space, at
+    #: ``passable_resolution`` (the map's), from the same ``origin``.
     passable: NDArray[np.bool_]
-    #: ``values`` with a border of inf cells (neighbour look-ups need no bounds checks).
-    padded: NDArray[np.float64]
+    passable_resolution: float
 
     def reachable(self, point: ArrayLike, radius_cells: int = 3) -> bool:
         """Whether the goal can be reached from ``point`` (a cell within ``radius_cells``
         of it is connected to the goal at the hard inflation)."""
         h, w = self.passable.shape
-        c = np.floor((np.asarray(point, float)[:2] - self.origin) / self.resolution).astype(int)
+        c = np.floor((np.asarray(point, float)[:2] - self.origin)
+                     / self.passable_resolution).astype(int)
         r0, r1 = max(c[1] - radius_cells, 0), min(c[1] + radius_cells + 1, h)
         c0, c1 = max(c[0] - radius_cells, 0), min(c[0] + radius_cells + 1, w)
         return bool(r0 < r1 and c0 < c1 and self.passable[r0:r1, c0:c1].any())
 
-    @property
-    def goal_reachable_cells(self) -> int:
-        return int(np.isfinite(self.values).sum())
+    @cached_property
+    def padded(self) -> NDArray[np.float64]:
+        """``values`` with a border of ``PAD`` inf cells (C-contiguous)."""
+        return np.pad(self.values, PAD, constant_values=np.inf)
 
-    def _corners(self, points: ArrayLike) -> tuple[NDArray, NDArray, NDArray]:
-        """Bilinear corners: (rows (n,4), cols (n,4), weights (n,4)), clipped to the patch."""
+    @cached_property
+    def _neighbour_offsets(self) -> NDArray[np.int64]:
+        """Flat offsets of the 8 neighbours in ``padded``."""
+        return NEIGHBOURS[:, 0] * (self.values.shape[1] + 2 * PAD) + NEIGHBOURS[:, 1]
+
+    def _corners(self, points: ArrayLike) -> tuple[NDArray[np.int64], NDArray[np.float64]]:
+        """Bilinear corners of each point: (flat indices into ``padded`` (n, 4), weights
+        (n, 4)); corners off the patch fall on the inf border."""
         p = np.atleast_2d(np.asarray(points, float))
         g = (p - self.origin) / self.resolution - 0.5   # continuous (col, row) of centres
-        c0 = np.floor(g).astype(np.int64)
-        f = g - c0
-        rows = np.stack([c0[:, 1], c0[:, 1], c0[:, 1] + 1, c0[:, 1] + 1], axis=1)
-        cols = np.stack([c0[:, 0], c0[:, 0] + 1, c0[:, 0], c0[:, 0] + 1], axis=1)
-        w = np.stack([(1 - f[:, 0]) * (1 - f[:, 1]), f[:, 0] * (1 - f[:, 1]),
-                      (1 - f[:, 0]) * f[:, 1], f[:, 0] * f[:, 1]], axis=1)
-        h, wd = self.values.shape
-        inside = (rows >= 0) & (rows < h) & (cols >= 0) & (cols < wd)
-        return np.clip(rows, 0, h - 1), np.clip(cols, 0, wd - 1), np.where(inside, w, 0.0)
+        base = np.floor(g)
+        f = g - base
+        h, w = self.values.shape
+        col = np.clip(base[:, 0], -2, w).astype(np.int64) + PAD
+        row = np.clip(base[:, 1], -2, h).astype(np.int64) + PAD
+        width = w + 2 * PAD
+        flat = (row * width + col)[:, None] + np.array([0, 1, width, width + 1])
+        fx, fy = f[:, 0:1], f[:, 1:2]
+        weights = np.where(_CORNER_RIGHT, fx, 1.0 - fx) * np.where(_CORNER_UP, fy, 1.0 - fy)
+        return flat, weights
 
     def value(self, points: ArrayLike) -> NDArray[np.float64]:
         """Field at each point (n,) [m], bilinear over the finite corners; inf where no
         corner is finite (inside an inflated obstacle, or off the patch)."""
-        rows, cols, w = self._corners(points)
-        v = self.values[rows, cols]
-        ok = np.isfinite(v) & (w > 0)
+        flat, w = self._corners(points)
+        v = self.padded.reshape(-1)[flat]
+        ok = np.isfinite(v)
         wsum = np.sum(np.where(ok, w, 0.0), axis=1)
-        num = np.sum(np.where(ok, w * np.where(ok, v, 0.0), 0.0), axis=1)
+        num = np.sum(np.where(ok, v, 0.0) * w, axis=1)
         with np.errstate(invalid='ignore', divide='ignore'):
             return np.where(wsum > 1e-9, num / np.maximum(wsum, 1e-12), np.inf)
 
-    def descent(self, rows: NDArray[np.int64], cols: NDArray[np.int64]) -> NDArray[np.float64]:
-        """Unit steepest-descent direction (..., 2) as (x, y) at cells (rows, cols) of the
-        patch: the sum of the unit vectors to the 8 neighbours weighted by how much lower
-        each is per metre; cut-off (inf) cells have none and count for none (zero)."""
-        padded = self.padded
-        v = padded[rows + 1, cols + 1]
+    def _descent(self, flat: NDArray[np.int64]) -> NDArray[np.float64]:
+        """Unit steepest-descent direction (..., 2) as (x, y) at cells given by flat indices
+        into ``padded``: the sum of the unit vectors to the 8 neighbours weighted by how
+        much lower each is per metre; cut-off (inf) cells have none and count for none."""
+        padded = self.padded.reshape(-1)
+        v = padded[flat]
         v = np.where(np.isfinite(v), v, -np.inf)    # a cut-off cell descends nowhere
-        nb = padded[rows[..., None] + 1 + NEIGHBOURS[:, 0], cols[..., None] + 1 + NEIGHBOURS[:, 1]]
-        drop = v[..., None] - nb                     # -inf towards or from cut-off cells
+        drop = v[..., None] - padded[flat[..., None] + self._neighbour_offsets]
         slope = np.where(drop > 0.0, drop, 0.0) / NEIGHBOUR_LENGTH
         acc = slope @ NEIGHBOUR_UNIT
-        norm = np.sqrt(acc[..., 0] ** 2 + acc[..., 1] ** 2)[..., None]
+        norm = np.hypot(acc[..., 0], acc[..., 1])[..., None]
         return np.where(norm > 1e-12, acc / np.maximum(norm, 1e-12), 0.0)
 
     def direction(self, points: ArrayLike) -> NDArray[np.float64]:
-        """Unit descent direction at each point (n, 2); where the point's corners have
-        none (inside an inflated obstacle), the direction to the nearest cell that has
-        one, within a few cells; zero when there is none either."""
+        """Unit descent direction at each point (n, 2): the bilinear blend of its corners'
+        steepest descents; where they have none (inside an inflated obstacle), the
+        direction to the nearest cell that has one, within a few cells; zero when there
+        is none either."""
         p = np.atleast_2d(np.asarray(points, float))
-        rows, cols, w = self._corners(p)
-        d = np.sum(self.descent(rows, cols) * w[..., None], axis=1)
-        norm = np.linalg.norm(d, axis=1)
+        flat, w = self._corners(p)
+        d = np.einsum('nk,nkj->nj', w, self._descent(flat))
+        norm = np.hypot(d[:, 0], d[:, 1])
         out = np.where(norm[:, None] > 1e-9, d / np.maximum(norm, 1e-12)[:, None], 0.0)
         for i in np.flatnonzero(norm <= 1e-9):
             out[i] = self._towards_free(p[i])
@@ -151,7 +166,7 @@ class NavigationField:
         strictly lower, else -1 (the goal, cut-off cells). Computed once per field."""
         h, w = self.values.shape
         p = self.padded
-        nb = np.stack([p[1 + dr:1 + dr + h, 1 + dc:1 + dc + w] for dr, dc in NEIGHBOURS])
+        nb = np.stack([p[PAD + dr:PAD + dr + h, PAD + dc:PAD + dc + w] for dr, dc in NEIGHBOURS])
         k = np.argmin(nb, axis=0)
         lower = np.take_along_axis(nb, k[None], axis=0)[0] < self.values
         rows, cols = np.indices((h, w))
@@ -192,15 +207,22 @@ def crop_box(occupied: NDArray[np.bool_], cells: NDArray[np.int64],
 
 def compute_field(occupied: NDArray[np.bool_], origin: ArrayLike, resolution: float,
                   goal: ArrayLike, robot: ArrayLike, robot_radius: float,
-                  clearance_band: float) -> NavigationField | None:
+                  clearance_band: float, coarsening: int = 1) -> NavigationField | None:
     """The navigation field to ``goal`` on an occupancy grid (see the module docstring).
 
+    ``coarsening`` > 1 marches on blocks of that many cells a side (fast marching
+    costs more than linearly in cells: 2 is about five times faster): a block is a
+    wall when any of its cells is occupied (a thin wall never leaks) and as fast as
+    its fastest cell (a narrow gap keeps its speed). Reachability stays decided on
+    the map's cells; if the blocks cut the robot off from a goal those cells reach
+    (a gap narrower than a block or two), the field is marched on the cells instead.
     ``goal`` outside the grid is replaced by the nearest cell of the grid's border.
     Returns None when the goal cell is within ``robot_radius`` of an occupied cell.
     """
     origin = np.asarray(origin, float)
     h, w = occupied.shape
     g = np.asarray(goal, float)[:2]
+    k = max(int(coarsening), 1)
 
     def cell(p: ArrayLike) -> NDArray[np.int64]:
         c = np.floor((np.asarray(p, float)[:2] - origin) / resolution).astype(int)[::-1]
@@ -210,6 +232,8 @@ def compute_field(occupied: NDArray[np.bool_], origin: ArrayLike, resolution: fl
     margin = int(math.ceil((CROP_MARGIN + robot_radius + clearance_band) / resolution))
     r0, r1, c0, c1 = crop_box(occupied, np.array([gc, rc]), margin)
     occ = occupied[r0:r1, c0:c1]
+    if k > 1:   # whole blocks: pad with unknown (free) cells beyond the grid
+        occ = np.pad(occ, ((0, -occ.shape[0] % k), (0, -occ.shape[1] % k)))
     clear = ndimage.distance_transform_edt(~occ) * resolution if occ.any() \
         else np.full(occ.shape, np.inf)
     free = clear >= robot_radius
@@ -219,18 +243,37 @@ def compute_field(occupied: NDArray[np.bool_], origin: ArrayLike, resolution: fl
     labels, _ = ndimage.label(free, structure=np.ones((3, 3)))
     passable = labels == labels[g_local]
     speed = np.clip((clear - robot_radius) / max(clearance_band, 1e-9), MIN_SPEED, 1.0)
-    phi = np.ones(occ.shape)
-    phi[g_local] = -1.0
-    try:
-        t = skfmm.travel_time(np.ma.MaskedArray(phi, occ), speed, dx=resolution)
-    except ValueError:   # no zero contour left after masking (degenerate patch)
+    if k > 1:
+        blocks = (occ.shape[0] // k, k, occ.shape[1] // k, k)
+        occ = occ.reshape(blocks).any(axis=(1, 3))
+        speed = speed.reshape(blocks).max(axis=(1, 3))
+    values = _travel_distance(occ, speed, (g_local[0] // k, g_local[1] // k), k * resolution)
+    if values is None:
         return None
-    values = np.ma.filled(np.ma.masked_invalid(t).astype(float), np.inf)
-    values[g_local] = 0.0
-    values = np.maximum(values, 0.0)
     patch_origin = origin + np.array([c0, r0]) * resolution
     goal_used = g if (0 <= (g - origin)[0] < w * resolution
                       and 0 <= (g - origin)[1] < h * resolution) \
         else origin + (gc[::-1] + 0.5) * resolution
-    return NavigationField(patch_origin, resolution, values, goal_used, passable,
-                           np.pad(values, 1, constant_values=np.inf))
+    field = NavigationField(patch_origin, k * resolution, values, goal_used, passable,
+                            resolution)
+    if k > 1 and field.reachable(robot) and not np.isfinite(field.value(robot)[0]):
+        return compute_field(occupied, origin, resolution, goal, robot, robot_radius,
+                             clearance_band, 1)
+    return field
+
+
+def _travel_distance(walls: NDArray[np.bool_], speed: NDArray[np.float64],
+                     goal: tuple[int, int], cell: float) -> NDArray[np.float64] | None:
+    """Fast-marching travel time from the ``goal`` cell at ``speed`` (relative, so metres
+    in open space) around ``walls``: inf where cut off; None for a degenerate patch."""
+    walls = walls.copy()
+    walls[goal] = False
+    phi = np.ones(walls.shape)
+    phi[goal] = -1.0
+    try:
+        t = skfmm.travel_time(np.ma.MaskedArray(phi, walls), speed, dx=cell)
+    except ValueError:   # no zero contour left after masking
+        return None
+    values = np.ma.filled(np.ma.masked_invalid(t).astype(float), np.inf)
+    values[goal] = 0.0
+    return np.maximum(values, 0.0)

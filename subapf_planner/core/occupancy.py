@@ -56,7 +56,7 @@ class OccupancyGrid:
         self.cells = max(8, int(math.ceil(size / resolution)))
         self.log_odds = np.zeros((self.cells, self.cells), np.float32)
         self.origin = np.array([-0.5, -0.5]) * self.cells * self.resolution
-        self.version = 0   # bumped whenever the occupied set may have changed
+        self.version = 0   # bumped whenever the occupied set (log odds > 0) changed
 
     # --- geometry ---------------------------------------------------------------------
     @property
@@ -141,31 +141,50 @@ class OccupancyGrid:
         use = hit | open_beam
         if not np.any(use):
             return
-        a, length = angles[use], lengths[use]
-        direction = np.column_stack((np.cos(a), np.sin(a)))
-        step = self.resolution
-        s = np.arange(0.5 * step, float(length.max()), step)
-        # free samples stop half a cell before a return, so its own cell is not cleared
-        stop = np.where(hit[use], length - 0.5 * step, length)
-        keep = s[None, :] < stop[:, None]
-        origin = np.array([lx, ly])
-        free = self._flat(origin + direction[:, None, :] * s[None, :, None], keep)
-        ends = self._flat(origin + direction[hit[use]] * length[hit[use], None])
-        # fancy-index assignment applies once per cell however many beams touch it
-        delta = np.zeros(self.log_odds.size, np.float32)
-        delta[free] = MISS
-        delta[ends] = HIT
-        self.log_odds += delta.reshape(self.log_odds.shape)
-        np.clip(self.log_odds, LOG_ODDS_MIN, LOG_ODDS_MAX, out=self.log_odds)
-        self.version += 1
+        a, length, ends_hit = angles[use], lengths[use], hit[use]
+        res = self.resolution
+        # free samples at (k + 1/2) cells along each beam, stopping half a cell before a
+        # return so its own cell is not cleared; built ragged (only the samples a beam has)
+        stop = np.where(ends_hit, length - 0.5 * res, length)
+        counts = np.maximum(np.ceil(stop / res - 0.5), 0).astype(np.int64)
+        beam = np.repeat(np.arange(a.size), counts)
+        k = np.arange(beam.size) - np.repeat(np.cumsum(counts) - counts, counts) + 0.5
+        # cells in a box around the laser that holds every beam (not the whole window)
+        n = self.cells
+        reach_cells = int(math.ceil(float(length.max()) / res)) + 1
+        lc = np.floor((np.array([lx, ly]) - self.origin) / res).astype(int)
+        c0, r0 = np.clip(lc - reach_cells, 0, n)
+        c1, r1 = np.clip(lc + reach_cells + 1, 0, n)
+        if c0 >= c1 or r0 >= r1:
+            return
+        box = (r0, r1, c0, c1)
+        x0 = (lx - self.origin[0]) / res - c0
+        y0 = (ly - self.origin[1]) / res - r0
+        c, s = np.cos(a), np.sin(a)
+        free = self._flat(x0 + c[beam] * k, y0 + s[beam] * k, box)
+        ends = self._flat(x0 + c[ends_hit] * length[ends_hit] / res,
+                          y0 + s[ends_hit] * length[ends_hit] / res, box)
+        # each touched cell changes once however many beams touch it; a return wins
+        mark = np.zeros((r1 - r0) * (c1 - c0), np.int8)
+        mark[free] = 1
+        mark[ends] = 2
+        touched = np.flatnonzero(mark)
+        rows, cols = np.divmod(touched, c1 - c0)
+        window = self.log_odds[r0:r1, c0:c1]   # a view
+        old = window[rows, cols]
+        new = np.clip(old + np.where(mark[touched] == 2, np.float32(HIT), np.float32(MISS)),
+                      LOG_ODDS_MIN, LOG_ODDS_MAX).astype(np.float32)
+        window[rows, cols] = new
+        if np.any((old > 0.0) != (new > 0.0)):
+            self.version += 1
 
-    def _flat(self, points: NDArray[np.float64],
-              keep: NDArray[np.bool_] | None = None) -> NDArray[np.int64]:
-        """Flat indices (with repeats) of the cells of ``points`` (..., 2) inside the window,
-        only where ``keep``."""
-        col = np.floor((points[..., 0] - self.origin[0]) / self.resolution).astype(np.int64)
-        row = np.floor((points[..., 1] - self.origin[1]) / self.resolution).astype(np.int64)
-        ok = (row >= 0) & (row < self.cells) & (col >= 0) & (col < self.cells)
-        if keep is not None:
-            ok &= keep
-        return row[ok] * self.cells + col[ok]
+    @staticmethod
+    def _flat(cols: NDArray[np.float64], rows: NDArray[np.float64],
+              box: tuple[int, int, int, int]) -> NDArray[np.int64]:
+        """Flat indices in ``box`` (r0, r1, c0, c1), with repeats, of the cells at
+        continuous (col, row) coordinates [cells from the box's corner] inside it."""
+        h, w = box[1] - box[0], box[3] - box[2]
+        col = np.floor(cols).astype(np.int64)
+        row = np.floor(rows).astype(np.int64)
+        ok = (row >= 0) & (row < h) & (col >= 0) & (col < w)
+        return row[ok] * w + col[ok]

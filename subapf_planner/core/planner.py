@@ -57,6 +57,17 @@ def _finite_points(obstacles: ArrayLike) -> NDArray[np.float64]:
     return obs[np.all(np.isfinite(obs), axis=1)]
 
 
+def local_radius(cfg: PlannerConfig) -> float:
+    """Obstacle points farther than this from the robot cannot change a planning cycle of
+    the APF methods [m]: the raw point and the samples lie within ``max_step + 2 *
+    sample_radius`` of it, and no term looks farther than the repulsion's influence (a
+    voxel's centroid may lie up to a voxel diagonal from its points), the Fig. 5
+    priority distance, the discard distance or the safety corridor."""
+    return (max(cfg.influence_distance + math.sqrt(2.0) * cfg.voxel_size,
+                cfg.priority_distance, cfg.discard_distance, cfg.safety_distance)
+            + cfg.max_step + 2.0 * cfg.sample_radius)
+
+
 def plan(cfg: PlannerConfig, pose: ArrayLike, goal: ArrayLike, obstacles: ArrayLike,
          previous: tuple[float, float] = (0.0, 0.0),
          field: NavigationField | None = None) -> PlanResult:
@@ -81,14 +92,16 @@ def plan(cfg: PlannerConfig, pose: ArrayLike, goal: ArrayLike, obstacles: ArrayL
         return PlanResult(Command(0.0, 0.0, Status.GOAL_IN_OBSTACLE), **common)
     if cfg.method == 'dwa':
         return _plan_dwa(cfg, pose, goal, obs, previous, common, field)
-    repulsors = voxel_downsample(obs, cfg.voxel_size)
+    offset = obs - position
+    near = obs[offset[:, 0] ** 2 + offset[:, 1] ** 2 <= local_radius(cfg) ** 2]
+    repulsors = voxel_downsample(near, cfg.voxel_size)
     raw = apf_step(position, goal, repulsors, cfg, field)[0]
     sampling = None
     target: NDArray | None = raw
     if cfg.method == 'subharmonic_sampling':
-        sampling = sample_and_choose(raw, position, goal, obs, repulsors, cfg, field)
+        sampling = sample_and_choose(raw, position, goal, near, repulsors, cfg, field)
         target = sampling.chosen
-    cmd = shape_command(pose, target, goal, previous, obs, cfg)
+    cmd = shape_command(pose, target, goal, previous, near, cfg)
     return PlanResult(cmd, raw, target, sampling, field=field, **common)
 
 
