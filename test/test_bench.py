@@ -8,7 +8,8 @@ from subapf_planner.core.config import PlannerConfig
 from subapf_planner.sim.episode import run_episode
 from subapf_planner.sim.simulator import SimConfig
 from subapf_planner.sim.world import load_world
-from subapf_planner.tools.bench import main
+from subapf_planner.tools.bench import DEFAULT_METHODS, main
+from subapf_planner.tools.plots import method_style
 
 pytestmark = pytest.mark.sim
 
@@ -70,3 +71,12 @@ def test_full_method_passes_narrow_and_tight_worlds_without_collision(worlds_dir
     for name in ('fig6a_narrow_obstacles', 'fig6b_tight_space', 'fig3_narrowing_passage'):
         world = load_world(worlds_dir / f'{name}.yaml')
         assert run_episode(world, PAPER).outcome == 'reached', name
+
+
+def test_every_default_method_is_drawn_its_own_way():
+    """Plots tell the methods apart: colour by method, line style by attraction field."""
+    styles = [method_style(m) for m in DEFAULT_METHODS]
+    assert len({(color, style) for color, style, _ in styles}) == len(DEFAULT_METHODS)
+    assert len({text for _, _, text in styles}) == len(DEFAULT_METHODS)
+    assert method_style('subharmonic_sampling:geodesic')[1] == '-'
+    assert method_style('subharmonic_sampling:euclidean')[1] == '--'

@@ -87,23 +87,25 @@ def test_window_reaches_towards_a_far_goal():
 
 
 # --- the field ------------------------------------------------------------------------
-def field_on(occ, goal, robot=(0.1, 0.1), inflation=0.0, soft=0.0):
-    return compute_field(occ, (0.0, 0.0), RES, goal, robot, inflation, soft)
+def field_on(occ, goal, robot=(0.1, 0.1), inflation=0.0, soft=0.0, coarsening=1):
+    return compute_field(occ, (0.0, 0.0), RES, goal, robot, inflation, soft, coarsening)
 
 
-@settings(max_examples=60, deadline=None)
+@settings(max_examples=80, deadline=None)
 @given(seed=st.integers(0, 2**31 - 1), fill=st.floats(0.0, 0.35),
-       inflation=st.sampled_from([0.0, 0.06, 0.125]), soft=st.sampled_from([0.0, 0.2]))
-def test_no_local_minimum_but_the_goal(seed, fill, inflation, soft):
-    """Every reachable cell but the goal's has an 8-neighbour with a strictly lower value."""
+       inflation=st.sampled_from([0.0, 0.06, 0.125]), soft=st.sampled_from([0.0, 0.2]),
+       coarsening=st.sampled_from([1, 2, 3]))
+def test_no_local_minimum_but_the_goal(seed, fill, inflation, soft, coarsening):
+    """Every reachable cell but the goal's has an 8-neighbour with a strictly lower value
+    (on the cells the field is marched on: map cells, or blocks of them)."""
     rng = np.random.default_rng(seed)
     occ = rng.random((40, 40)) < fill
     free = np.argwhere(~occ)
     if len(free) == 0:
         return
     gr, gc = free[rng.integers(len(free))]
-    f = field_on(occ, ((gc + 0.5) * RES, (gr + 0.5) * RES), ((gc + 0.5) * RES,
-                                                              (gr + 0.5) * RES), inflation, soft)
+    goal = ((gc + 0.5) * RES, (gr + 0.5) * RES)
+    f = field_on(occ, goal, goal, inflation, soft, coarsening)
     if f is None:                               # goal inside the inflation
         return
     v = f.values                                # (the patch the field was computed on)
@@ -116,15 +118,17 @@ def test_no_local_minimum_but_the_goal(seed, fill, inflation, soft):
     assert np.all(lowest[reachable] < v[reachable])
 
 
-def test_field_is_close_to_euclidean_in_open_space_and_agrees_with_differences():
+@pytest.mark.parametrize('coarsening', [1, 2])
+def test_field_is_close_to_euclidean_in_open_space_and_agrees_with_differences(coarsening):
     occ = np.zeros((200, 200), bool)
     goal = np.array([5.0, 5.0])
-    f = field_on(occ, goal, robot=(9.0, 9.0))   # the patch: robot, goal and a margin
+    f = field_on(occ, goal, robot=(9.0, 9.0), coarsening=coarsening)   # robot, goal, margin
+    assert f.resolution == pytest.approx(coarsening * RES)
     rng = np.random.default_rng(3)
     pts = rng.uniform(4.5, 8.5, (200, 2))   # inside the patch, off its border
-    pts = pts[np.hypot(*(pts - goal).T) > 0.5]
+    pts = pts[np.hypot(*(pts - goal).T) > 10 * f.resolution]   # 8-neighbour quantisation
     d = np.hypot(*(pts - goal).T)
-    assert np.all(np.abs(f.value(pts) - d) <= 0.02 * d + 2 * RES)   # fast marching: ~Euclid
+    assert np.all(np.abs(f.value(pts) - d) <= 0.02 * d + 2 * f.resolution)   # ~Euclidean
     # the descent direction points at the goal, and matches -grad by central differences
     dirs = f.direction(pts)
     to_goal = (goal - pts) / d[:, None]
@@ -138,7 +142,8 @@ def test_field_is_close_to_euclidean_in_open_space_and_agrees_with_differences()
     assert np.all(cos > math.cos(math.radians(8)))
 
 
-def test_the_field_goes_round_a_wall_and_through_a_narrow_gap():
+@pytest.mark.parametrize('coarsening', [1, 2])
+def test_the_field_goes_round_a_wall_and_through_a_narrow_gap(coarsening):
     occ = np.zeros((100, 100), bool)
     occ[50, :] = True                            # a wall across y = 2.525 m
     gap = slice(40, 40 + 6)                      # 6 cells = 0.30 m of free cells
@@ -146,24 +151,39 @@ def test_the_field_goes_round_a_wall_and_through_a_narrow_gap():
     cfg = PlannerConfig()
     inflation = cfg.inflation_radius
     f = field_on(occ, (2.0, 4.0), robot=(2.0, 1.0), inflation=inflation,
-                 soft=cfg.inflation_band)
+                 soft=cfg.inflation_band, coarsening=coarsening)
     assert f is not None
     start = np.array([4.5, 1.0])
     assert np.isfinite(f.value(start)[0]) and f.reachable(start)
     path = f.path(start)
     crossing = path[np.argmin(np.abs(path[:, 1] - 2.525))]
     assert 2.0 <= crossing[0] <= 2.3             # through the gap
-    assert np.hypot(*(path[-1] - (2.0, 4.0))) < 2 * RES
+    assert np.hypot(*(path[-1] - (2.0, 4.0))) < 2 * f.resolution
     # closed wall: the other side cannot be reached
     occ[50, gap] = True
-    f = field_on(occ, (2.0, 4.0), robot=(2.0, 1.0), inflation=inflation)
+    f = field_on(occ, (2.0, 4.0), robot=(2.0, 1.0), inflation=inflation,
+                 coarsening=coarsening)
     assert not np.isfinite(f.value(start)[0]) and not f.reachable(start)
     # a gap narrower than twice the inflation radius: the field goes through it (slowly,
     # so that a robot pushed into it is led on), but the goal counts as unreachable
     occ[50, 42:45] = False                       # 3 cells = 0.15 m
     f = field_on(occ, (2.0, 4.0), robot=(2.0, 1.0), inflation=inflation,
-                 soft=cfg.inflation_band)
+                 soft=cfg.inflation_band, coarsening=coarsening)
     assert np.isfinite(f.value(start)[0]) and not f.reachable(start)
+
+
+def test_a_gap_the_blocks_close_is_marched_on_the_map_cells():
+    """Two free cells between walls, straddling two blocks: every block holds a wall, so
+    the coarse field is cut at the gap; the map cells pass a small robot through it."""
+    occ = np.zeros((60, 60), bool)
+    occ[30, :] = True
+    occ[30, 29:31] = False                       # cells 29 and 30: blocks (28, 29), (30, 31)
+    goal, robot = (1.5, 2.5), (1.5, 0.5)
+    coarse = field_on(occ, goal, robot, inflation=0.04, coarsening=2)
+    fine = field_on(occ, goal, robot, inflation=0.04, coarsening=1)
+    assert coarse.resolution == pytest.approx(RES)          # fell back to the map cells
+    assert np.array_equal(coarse.values, fine.values)
+    assert coarse.value(robot)[0] == pytest.approx(2.0, abs=0.1)   # straight through
 
 
 def test_goal_in_an_inflated_obstacle_has_no_field():

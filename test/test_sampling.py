@@ -9,13 +9,17 @@ import numpy as np
 import pytest
 
 from subapf_planner.core.apf import apf_force, apf_step
+from subapf_planner.core.command import shape_command
 from subapf_planner.core.config import PlannerConfig
+from subapf_planner.core.planner import local_radius, plan
 from subapf_planner.core.sampling import (
     circle_samples,
     clearance,
     priority_applies,
     sample_and_choose,
 )
+from subapf_planner.core.scan import voxel_downsample
+from subapf_planner.core.status import Status
 
 pytestmark = pytest.mark.core
 
@@ -107,3 +111,43 @@ def test_inputs_not_mutated():
     np.testing.assert_array_equal(obs, obs0)
     assert pos.tolist() == [0.0, 0.0]
     assert math.isinf(clearance([0, 0], np.zeros((0, 2)))[0])
+
+
+@pytest.mark.parametrize('cfg', [CFG, PAPER, PAPER.replace(repulsion_mode='sum'),
+                                 PAPER.replace(method='traditional', influence_distance=0.3)],
+                         ids=['default', 'paper', 'sum', 'traditional'])
+@given(seed=st.integers(0, 2**31 - 1), yaw=st.floats(-math.pi, math.pi),
+       gx=coords, gy=coords)
+@settings(max_examples=150, deadline=None)
+def test_points_beyond_the_local_radius_change_nothing(cfg, seed, yaw, gx, gy):
+    """plan() skips obstacle points farther than local_radius() from the robot; the cycle
+    computed on every point (what it skips included) gives the same command."""
+    rng = np.random.default_rng(seed)
+    radius = local_radius(cfg)
+    # points on both sides of the local radius, and a few near the robot
+    ring = rng.uniform(radius - 0.4, radius + 0.4, 120)
+    angle = rng.uniform(-math.pi, math.pi, ring.size)
+    obs = np.vstack([np.column_stack((ring * np.cos(angle), ring * np.sin(angle))),
+                     rng.uniform(-1.2, 1.2, (rng.integers(0, 12), 2))])
+    obs = obs[np.hypot(*obs.T) > 0.2]
+    pose, goal = np.array([0.0, 0.0, yaw]), np.array([gx, gy])
+    result = plan(cfg, pose, goal, obs)
+    repulsors = voxel_downsample(obs, cfg.voxel_size)
+    raw = apf_step(pose[:2], goal, repulsors, cfg)[0]
+    target = raw
+    if result.command.status is Status.GOAL_IN_OBSTACLE:
+        return
+    if cfg.method == 'subharmonic_sampling':
+        sampling = sample_and_choose(raw, pose[:2], goal, obs, repulsors, cfg)
+        target = sampling.chosen
+        np.testing.assert_allclose(result.sampling.scores, sampling.scores, rtol=0, atol=1e-12)
+        assert result.sampling.priority_index == sampling.priority_index
+    expected = shape_command(pose, target, goal, (0.0, 0.0), obs, cfg)
+    np.testing.assert_allclose(result.raw_point, raw, rtol=0, atol=1e-12)
+    if target is None:
+        assert result.chosen_point is None
+    else:
+        np.testing.assert_allclose(result.chosen_point, target, rtol=0, atol=1e-12)
+    assert result.command.status == expected.status
+    assert result.command.v == pytest.approx(expected.v, abs=1e-9)
+    assert result.command.w == pytest.approx(expected.w, abs=1e-9)

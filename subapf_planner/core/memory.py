@@ -2,8 +2,10 @@
 
 Integrates each scan once (at the laser's odom pose when it was taken) and
 recomputes the field when the goal changes, when the robot leaves the patch
-the field covers, or, when the grid changed, at most every ``field_period``
-seconds (the field is the expensive part of a cycle; core/navigation.py).
+the field covers, or, when the occupied cells changed, at most every
+``field_period`` seconds (the field is the expensive part of a cycle;
+core/navigation.py). A scan that only confirms what the map holds changes no
+occupied cell and costs no field.
 """
 
 from __future__ import annotations
@@ -40,6 +42,7 @@ class NavigationMemory:
         self._field_time = -math.inf
         self._scan_stamp: float | None = None
         self.recomputed = False   # whether the last field_for() computed a new field
+        self.computations = 0     # fields computed so far
 
     def reconfigure(self, cfg: PlannerConfig) -> None:
         """A new configuration; a new map size or resolution starts an empty map."""
@@ -78,7 +81,7 @@ class NavigationMemory:
     def field_for(self, position: ArrayLike, goal: ArrayLike,
                   now: float | None = None) -> NavigationField | None:
         """The field to ``goal`` (None: the goal is blocked in the map), recomputed per the
-        module docstring; ``now`` None recomputes whenever the grid changed."""
+        module docstring; ``now`` None recomputes whenever the occupied cells changed."""
         p = np.asarray(position, float)[:2]
         g = np.asarray(goal, float)[:2]
         key = (tuple(np.round(g / SAME_GOAL).astype(int)), self.grid.version)
@@ -95,4 +98,5 @@ class NavigationMemory:
         self._field_key = key
         self._field_time = -math.inf if now is None else now
         self.recomputed = True
+        self.computations += 1
         return self.field

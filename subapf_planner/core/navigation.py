@@ -19,7 +19,11 @@ all is decided on the hard inflation: the free cells at least ``robot_radius``
 from every occupied cell, connected (``reachable``). The field is computed on
 the part of the grid that matters: the bounding box of the occupied cells, the
 robot and the goal, grown by ``CROP_MARGIN`` (outside it everything is unknown,
-i.e. free, so the box changes no route through obstacles).
+i.e. free, so the box changes no route through obstacles). The marching runs on
+blocks of ``coarsening`` x ``coarsening`` map cells (a block is a wall when any
+of its cells is occupied, and as fast as its fastest cell); reachability stays
+on the map cells, and a robot the blocks cut off from a goal the cells reach is
+given a field marched on the cells.
 Units: values in metres of free-space travel (seconds at 1 m/s).
 """
 
@@ -46,6 +50,8 @@ NEIGHBOUR_UNIT = NEIGHBOURS[:, ::-1] / NEIGHBOUR_LENGTH[:, None]
 #: Border of inf cells around a field's values: the bilinear corners of any point, and
 #: their neighbours, index the padded array with no bounds checks.
 PAD = 3
+#: Single-point directions a field remembers (the newest).
+SINGLE_DIRECTIONS_KEPT = 4
 #: Bilinear corners (col + 0|1, row + 0|1), in the order of the weights.
 _CORNER_RIGHT = np.array([False, True, False, True])
 _CORNER_UP = np.array([False, False, True, True])
@@ -133,13 +139,25 @@ class NavigationField:
         direction to the nearest cell that has one, within a few cells; zero when there
         is none either."""
         p = np.atleast_2d(np.asarray(points, float))
+        key = p.tobytes() if p.shape[0] == 1 else None
+        if key in self._single_directions:
+            return self._single_directions[key].copy()
         flat, w = self._corners(p)
         d = np.einsum('nk,nkj->nj', w, self._descent(flat))
         norm = np.hypot(d[:, 0], d[:, 1])
         out = np.where(norm[:, None] > 1e-9, d / np.maximum(norm, 1e-12)[:, None], 0.0)
         for i in np.flatnonzero(norm <= 1e-9):
             out[i] = self._towards_free(p[i])
+        if key is not None:
+            if len(self._single_directions) >= SINGLE_DIRECTIONS_KEPT:
+                del self._single_directions[next(iter(self._single_directions))]
+            self._single_directions[key] = out.copy()
         return out
+
+    @cached_property
+    def _single_directions(self) -> dict[bytes | None, NDArray[np.float64]]:
+        """The last few single-point directions (a cycle asks for the robot's twice)."""
+        return {}
 
     def _towards_free(self, point: NDArray[np.float64], radius_cells: int = 6) -> NDArray:
         h, wd = self.values.shape
@@ -197,9 +215,8 @@ def crop_box(occupied: NDArray[np.bool_], cells: NDArray[np.int64],
              margin: int) -> tuple[int, int, int, int]:
     """(r0, r1, c0, c1): the box of the occupied cells and ``cells`` (k, 2), grown by
     ``margin`` cells and clipped to the grid."""
-    rows, cols = np.nonzero(occupied)
-    rs = np.concatenate([rows, cells[:, 0]])
-    cs = np.concatenate([cols, cells[:, 1]])
+    rs = np.concatenate([np.flatnonzero(occupied.any(axis=1)), cells[:, 0]])
+    cs = np.concatenate([np.flatnonzero(occupied.any(axis=0)), cells[:, 1]])
     h, w = occupied.shape
     return (max(int(rs.min()) - margin, 0), min(int(rs.max()) + margin + 1, h),
             max(int(cs.min()) - margin, 0), min(int(cs.max()) + margin + 1, w))

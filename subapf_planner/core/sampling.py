@@ -156,7 +156,9 @@ def sample_and_choose(raw_point: ArrayLike, position: ArrayLike, goal: ArrayLike
         p = np.asarray(position, float)
         dist = np.hypot(*(obs - p).T)
         i_near = int(np.argmin(dist))
-        if priority_applies(p, heading_target(p, goal, field), obs[i_near], cfg):
+        # (the nearest point's distance first: the field's direction is not free)
+        if dist[i_near] < cfg.priority_distance and priority_applies(
+                p, heading_target(p, goal, field), obs[i_near], cfg):
             raw_clear = float(clearance(raw_point, obs)[0])
             keep = raw_clear - PRIORITY_SLACK * cfg.sample_radius
             ok = np.flatnonzero(np.isfinite(scores) & (clear >= keep))

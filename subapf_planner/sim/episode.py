@@ -39,6 +39,8 @@ class EpisodeResult:
     plan_ms: np.ndarray
     final_distance: float
     statuses: dict[str, int] = field(default_factory=dict)
+    #: Per planning cycle, whether it computed a new navigation field.
+    field_recomputed: np.ndarray = field(default_factory=lambda: np.zeros(0, bool))
 
     @property
     def cycles(self) -> int:
@@ -82,7 +84,7 @@ def run_episode(world: World, cfg: PlannerConfig, sim_cfg: SimConfig | None = No
     cfg = cfg.replace(goal_tolerance=min(cfg.goal_tolerance, world.goal_tolerance))
     ctl = PlannerController(cfg, limits)
     ctl.set_goal(np.asarray(world.goal, float))
-    path, plan_ms, statuses = [], [], {}
+    path, plan_ms, recomputed, statuses = [], [], [], {}
     with BurgerSim(world, sim_cfg) as sim:
         while True:
             truth = sim.true_pose()
@@ -98,10 +100,12 @@ def run_episode(world: World, cfg: PlannerConfig, sim_cfg: SimConfig | None = No
             delivery.capture(sim.scan(), now)
             for scan in delivery.due(now):
                 ctl.update_scan(scan_input(scan), now)
+            computations = ctl.planner.memory.computations
             t0 = time.perf_counter()
             decision = ctl.tick(now)
             if decision.result is not None:
                 plan_ms.append((time.perf_counter() - t0) * 1e3)
+                recomputed.append(ctl.planner.memory.computations > computations)
             key = str(decision.result.command.status) if decision.result is not None \
                 else decision.text
             statuses[key] = statuses.get(key, 0) + 1
@@ -111,4 +115,4 @@ def run_episode(world: World, cfg: PlannerConfig, sim_cfg: SimConfig | None = No
         final = float(np.hypot(*(sim.true_pose()[:2] - np.asarray(world.goal, float))))
         elapsed = sim.time
     return EpisodeResult(world.name, label or cfg.method, outcome, elapsed, np.asarray(path),
-                         np.asarray(plan_ms), final, statuses)
+                         np.asarray(plan_ms), final, statuses, np.asarray(recomputed, bool))

@@ -22,8 +22,10 @@ from ..sim.episode import run_episode
 from ..sim.simulator import SimConfig
 from ..sim.world import load_world, world_files
 
-#: Bytes per field cell: values (float64), descent (2 x float64), passable (bool).
-FIELD_BYTES_PER_CELL = 8 + 16 + 1
+#: Bytes a field holds per block it is marched on: values, their padded copy and the
+#: downhill index for ~/plan (8 bytes each); and per map cell: passable (bool).
+FIELD_BYTES_PER_BLOCK = 3 * 8
+FIELD_BYTES_PER_MAP_CELL = 1
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -40,21 +42,30 @@ def main(argv: list[str] | None = None) -> int:
     cfg = load_config(args.params or default_params_file(), **changes)
     files = world_files(args.worlds or [shipped_worlds_dir()])
     t0 = time.perf_counter()
-    ms = []
-    for f in files:
-        ms.append(run_episode(load_world(f), cfg, SimConfig(range_noise=0.01)).plan_ms)
-    ms = np.concatenate(ms)
+    runs = [run_episode(load_world(f), cfg, SimConfig(range_noise=0.01)) for f in files]
+    ms = np.concatenate([r.plan_ms for r in runs])
+    recomputed = np.concatenate([r.field_recomputed for r in runs])
     cells = int(np.ceil(cfg.map_size / cfg.map_resolution)) ** 2
     print(f'method={cfg.method} attraction_field={cfg.attraction_field} '
           f'map={cfg.map_size:g} m at {cfg.map_resolution:g} m ({cells} cells) '
           f'field_period={cfg.field_period:g} s worlds={len(files)} cycles={ms.size} '
           f'({time.perf_counter() - t0:.0f} s)')
-    print(f'plan cycle ms: min {ms.min():.3f}  median {np.median(ms):.3f}  '
-          f'p99 {np.percentile(ms, 99):.3f}  max {ms.max():.3f}')
+    print(f'plan cycle ms: {_figures(ms)}')
+    if recomputed.any():
+        print(f'  {recomputed.sum()} cycles with a new field ({recomputed.mean():.0%}): '
+              f'{_figures(ms[recomputed])}')
+        print(f'  {(~recomputed).sum()} cycles without: {_figures(ms[~recomputed])}')
     if cfg.geodesic:
+        field_bytes = cells * (FIELD_BYTES_PER_BLOCK / cfg.field_coarsening ** 2
+                               + FIELD_BYTES_PER_MAP_CELL)
         print(f'memory: occupancy window {cells * 4 / 2**20:.2f} MiB (float32), field at most '
-              f'{cells * FIELD_BYTES_PER_CELL / 2**20:.2f} MiB (the whole window)')
+              f'{field_bytes / 2**20:.2f} MiB (the whole window)')
     return 0
+
+
+def _figures(ms: np.ndarray) -> str:
+    return (f'min {ms.min():.3f}  median {np.median(ms):.3f}  p99 {np.percentile(ms, 99):.3f}'
+            f'  max {ms.max():.3f}')
 
 
 if __name__ == '__main__':

@@ -20,6 +20,17 @@ METHOD_STYLE = {
     'harmonic': ('tab:green', 'harmonic log'),
     'dwa': ('tab:purple', 'DWA'),
 }
+#: Line style of each attraction field in a method label ``method[:field]``.
+FIELD_STYLE = {'geodesic': ('-', 'geodesic'), 'euclidean': ('--', 'euclidean')}
+
+
+def method_style(label: str) -> tuple[str, str, str]:
+    """(colour, line style, legend text) of a benchmark method label: the colour says
+    the method, the line style the attraction field (solid geodesic, dashed Euclidean)."""
+    method, _, field = label.partition(':')
+    color, text = METHOD_STYLE.get(method, ('k', method))
+    style, field_text = FIELD_STYLE.get(field, ('-', field))
+    return color, style, f'{text}, {field_text}' if field_text else text
 
 
 def draw_world(ax: plt.Axes, world: World) -> None:
@@ -43,9 +54,9 @@ def plot_trajectories(world: World, paths: Mapping[str, np.ndarray],
     fig, ax = plt.subplots(figsize=(6.5, 6.5))
     draw_world(ax, world)
     for method, path in paths.items():
-        color, label = METHOD_STYLE.get(method, ('k', method))
+        color, style, label = method_style(method)
         if len(path):
-            ax.plot(path[:, 0], path[:, 1], color=color, lw=1.6,
+            ax.plot(path[:, 0], path[:, 1], color=color, ls=style, lw=1.6,
                     label=f'{label}: {outcomes.get(method, "?")}', zorder=3)
             ax.plot(path[-1, 0], path[-1, 1], 'o', color=color, ms=4, zorder=3)
     ax.set_title(world.name)
