@@ -51,6 +51,11 @@ def forward_blocked(pose: ArrayLike, obstacles: ArrayLike, cfg: PlannerConfig) -
     return bool(np.any(hit))
 
 
+def _clamp(value: float, limit: float) -> float:
+    """``value`` within [-limit, limit] (limit >= 0)."""
+    return min(max(float(value), -limit), limit)
+
+
 def _rate_limit(value: float, previous: float, max_rate: float, dt: float) -> float:
     step = max_rate * dt
     return min(max(value, previous - step), previous + step)
@@ -70,8 +75,7 @@ def shape_command(pose: ArrayLike, target: ArrayLike | None, goal: ArrayLike,
     tx, ty = (float(v) for v in target)
     dist = math.hypot(tx - x, ty - y)
     alpha = wrap_angle(math.atan2(ty - y, tx - x) - yaw) if dist > 1e-9 else 0.0
-    w = float(np.clip(cfg.heading_gain * alpha, -cfg.max_angular_velocity,
-                      cfg.max_angular_velocity))
+    w = _clamp(cfg.heading_gain * alpha, cfg.max_angular_velocity)
     if abs(alpha) > cfg.rotate_in_place_angle:
         v, status = 0.0, Status.TURNING
     else:
@@ -84,7 +88,7 @@ def shape_command(pose: ArrayLike, target: ArrayLike | None, goal: ArrayLike,
     v = _rate_limit(v, v_prev, cfg.max_linear_acceleration, cfg.period)
     w = _rate_limit(w, w_prev, cfg.max_angular_acceleration, cfg.period)
     v = min(max(v, 0.0), cfg.max_linear_velocity)
-    w = float(np.clip(w, -cfg.max_angular_velocity, cfg.max_angular_velocity))
+    w = _clamp(w, cfg.max_angular_velocity)
     if v > 0.0 and forward_blocked(pose, obstacles, cfg):
         v, status = 0.0, Status.BLOCKED_AHEAD
     return Command(v, w, status)

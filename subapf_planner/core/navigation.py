@@ -101,8 +101,9 @@ class NavigationField:
         base = np.floor(g)
         f = g - base
         h, w = self.values.shape
-        col = np.clip(base[:, 0], -2, w).astype(np.int64) + PAD
-        row = np.clip(base[:, 1], -2, h).astype(np.int64) + PAD
+        # (np.minimum/np.maximum: np.clip costs more on a few points)
+        col = np.minimum(np.maximum(base[:, 0], -2), w).astype(np.int64) + PAD
+        row = np.minimum(np.maximum(base[:, 1], -2), h).astype(np.int64) + PAD
         width = w + 2 * PAD
         flat = (row * width + col)[:, None] + np.array([0, 1, width, width + 1])
         fx, fy = f[:, 0:1], f[:, 1:2]

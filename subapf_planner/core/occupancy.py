@@ -152,12 +152,15 @@ class OccupancyGrid:
         # cells in a box around the laser that holds every beam (not the whole window)
         n = self.cells
         reach_cells = int(math.ceil(float(length.max()) / res)) + 1
-        lc = np.floor((np.array([lx, ly]) - self.origin) / res).astype(int)
-        c0, r0 = np.clip(lc - reach_cells, 0, n)
-        c1, r1 = np.clip(lc + reach_cells + 1, 0, n)
+        lc = math.floor((lx - self.origin[0]) / res)
+        lr = math.floor((ly - self.origin[1]) / res)
+        c0, r0 = min(max(lc - reach_cells, 0), n), min(max(lr - reach_cells, 0), n)
+        c1, r1 = min(max(lc + reach_cells + 1, 0), n), min(max(lr + reach_cells + 1, 0), n)
         if c0 >= c1 or r0 >= r1:
             return
-        box = (r0, r1, c0, c1)
+        # a box the window does not cut holds every sample: no bounds checks needed
+        box = (r0, r1, c0, c1, (c0, r0) != (lc - reach_cells, lr - reach_cells)
+               or (c1, r1) != (lc + reach_cells + 1, lr + reach_cells + 1))
         x0 = (lx - self.origin[0]) / res - c0
         y0 = (ly - self.origin[1]) / res - r0
         c, s = np.cos(a), np.sin(a)
@@ -172,19 +175,23 @@ class OccupancyGrid:
         rows, cols = np.divmod(touched, c1 - c0)
         window = self.log_odds[r0:r1, c0:c1]   # a view
         old = window[rows, cols]
-        new = np.clip(old + np.where(mark[touched] == 2, np.float32(HIT), np.float32(MISS)),
-                      LOG_ODDS_MIN, LOG_ODDS_MAX).astype(np.float32)
+        new = np.minimum(np.maximum(
+            old + np.where(mark[touched] == 2, np.float32(HIT), np.float32(MISS)),
+            np.float32(LOG_ODDS_MIN)), np.float32(LOG_ODDS_MAX))
         window[rows, cols] = new
         if np.any((old > 0.0) != (new > 0.0)):
             self.version += 1
 
     @staticmethod
     def _flat(cols: NDArray[np.float64], rows: NDArray[np.float64],
-              box: tuple[int, int, int, int]) -> NDArray[np.int64]:
-        """Flat indices in ``box`` (r0, r1, c0, c1), with repeats, of the cells at
-        continuous (col, row) coordinates [cells from the box's corner] inside it."""
-        h, w = box[1] - box[0], box[3] - box[2]
+              box: tuple[int, int, int, int, bool]) -> NDArray[np.int64]:
+        """Flat indices in ``box`` (r0, r1, c0, c1, cut), with repeats, of the cells at
+        continuous (col, row) coordinates [cells from the box's corner] inside it; with
+        ``cut`` False every point is known to lie inside."""
+        h, w, cut = box[1] - box[0], box[3] - box[2], box[4]
         col = np.floor(cols).astype(np.int64)
         row = np.floor(rows).astype(np.int64)
+        if not cut:
+            return row * w + col
         ok = (row >= 0) & (row < h) & (col >= 0) & (col < w)
         return row[ok] * w + col[ok]

@@ -35,20 +35,34 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument('--field', default=None, choices=('geodesic', 'euclidean'),
                    help="attraction field (default: the params file's)")
     p.add_argument('--params', default=None, help='params YAML (default: config/planner.yaml)')
+    p.add_argument('--repeat', type=int, default=1,
+                   help='drive the worlds this many times and pool the cycles (a shared '
+                   'machine is faster and slower by turns; each pass prints its median)')
     args = p.parse_args(argv)
+    if args.repeat < 1:
+        p.error('--repeat must be at least 1')
     changes = {'method': args.method}
     if args.field:
         changes['attraction_field'] = args.field
     cfg = load_config(args.params or default_params_file(), **changes)
     files = world_files(args.worlds or [shipped_worlds_dir()])
     t0 = time.perf_counter()
-    runs = [run_episode(load_world(f), cfg, SimConfig(range_noise=0.01)) for f in files]
+    worlds = [load_world(f) for f in files]
+    runs = []
+    for k in range(args.repeat):
+        runs_k = [run_episode(w, cfg, SimConfig(range_noise=0.01)) for w in worlds]
+        if args.repeat > 1:
+            pass_ms = np.concatenate([r.plan_ms for r in runs_k])
+            print(f'pass {k + 1}: median {np.median(pass_ms):.3f} ms  '
+                  f'p99 {np.percentile(pass_ms, 99):.3f} ms')
+        runs += runs_k
     ms = np.concatenate([r.plan_ms for r in runs])
     recomputed = np.concatenate([r.field_recomputed for r in runs])
     cells = int(np.ceil(cfg.map_size / cfg.map_resolution)) ** 2
     print(f'method={cfg.method} attraction_field={cfg.attraction_field} '
           f'map={cfg.map_size:g} m at {cfg.map_resolution:g} m ({cells} cells) '
-          f'field_period={cfg.field_period:g} s worlds={len(files)} cycles={ms.size} '
+          f'field_period={cfg.field_period:g} s worlds={len(files)} x {args.repeat} '
+          f'cycles={ms.size} '
           f'({time.perf_counter() - t0:.0f} s)')
     print(f'plan cycle ms: {_figures(ms)}')
     if recomputed.any():
