@@ -9,7 +9,7 @@ import pytest
 
 from subapf_planner.core.config import PlannerConfig
 from subapf_planner.core.memory import NavigationMemory
-from subapf_planner.core.navigation import NEIGHBOURS, compute_field
+from subapf_planner.core.navigation import NEIGHBOURS, compute_field, thin_polyline
 from subapf_planner.core.occupancy import LOG_ODDS_MAX, OccupancyGrid
 from subapf_planner.core.planner import Planner
 from subapf_planner.core.status import Status
@@ -230,3 +230,14 @@ def test_memory_recomputes_on_a_new_goal_and_at_most_every_field_period():
     mem.integrate(*enclosure_scan(1.2), (0.0, 0.0, 0.0), 3.0)
     mem.field_for((0, 0), (0.0, 1.0), now=3.0)
     assert not mem.recomputed                    # the same walls seen again: no change
+
+
+def test_a_thinned_polyline_keeps_its_ends_and_its_spacing():
+    line = np.column_stack((np.arange(0.0, 2.05, 0.1), np.zeros(21)))   # 2 m in 0.1 m steps
+    thin = thin_polyline(line, 0.25)
+    np.testing.assert_allclose(thin[0], line[0])
+    np.testing.assert_allclose(thin[-1], line[-1])
+    gaps = np.diff(thin[:, 0])
+    assert np.all(gaps[:-1] >= 0.25 - 1e-9) and np.all(gaps[:-1] <= 0.3 + 1e-9)
+    assert len(thin) < len(line)
+    np.testing.assert_allclose(thin_polyline(line[:2], 0.25), line[:2])   # too short: as is

@@ -212,6 +212,23 @@ class NavigationField:
         return self.origin + (rc[:, ::-1] + 0.5) * self.resolution
 
 
+def thin_polyline(points: ArrayLike, spacing: float) -> NDArray[np.float64]:
+    """The points (k, 2) of a polyline at least ``spacing`` [m] apart along it, walking
+    from the first, which is kept, as is the last."""
+    p = np.asarray(points, float).reshape(-1, 2)
+    if len(p) < 3 or spacing <= 0.0:
+        return p.copy()
+    along = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(p, axis=0).T))])
+    keep = [0]
+    while True:   # the next point at least ``spacing`` further along
+        nxt = int(np.searchsorted(along, along[keep[-1]] + spacing - 1e-9))
+        if nxt >= len(p) - 1:
+            break
+        keep.append(nxt)
+    keep.append(len(p) - 1)
+    return p[keep]
+
+
 def crop_box(occupied: NDArray[np.bool_], cells: NDArray[np.int64],
              margin: int) -> tuple[int, int, int, int]:
     """(r0, r1, c0, c1): the box of the occupied cells and ``cells`` (k, 2), grown by

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import array
 import math
 
 from builtin_interfaces.msg import Time
@@ -128,7 +129,7 @@ def grid_to_msg(grid: OccupancyGrid, frame: str, stamp: Time) -> GridMsg:
     lo = grid.log_odds.astype(np.float64)
     data = np.rint(100.0 / (1.0 + np.exp(-lo))).astype(np.int8)
     data[lo == 0.0] = -1
-    msg.data = data.ravel().tolist()
+    msg.data = array.array('b', data.tobytes())   # (a list is checked element by element)
     return msg
 
 

@@ -34,6 +34,7 @@ from visualization_msgs.msg import MarkerArray
 
 from ..core.config import ConfigError, PlannerConfig
 from ..core.controller import PlannerController, Supervision
+from ..core.navigation import thin_polyline
 from ..core.params import check_fields, param
 from ..core.scan import geometry_warning
 from .conversions import (
@@ -52,6 +53,9 @@ from .spinning import spin_node
 NODE_NAME = 'subapf_planner'
 #: A forward clock jump longer than this, or any backward one, resets the inputs [s].
 CLOCK_JUMP = 1.0
+#: Points of ~/plan are this far apart, and it is sent again when the robot moved this
+#: far (or for a new field, or after a second) [m].
+PLAN_SPACING = 0.25
 
 
 
@@ -105,6 +109,7 @@ class PlannerNode(Node):
         self.map_pub = self.create_publisher(GridMsg, '~/map', LATCHED)
         self.plan_pub = self.create_publisher(Path, '~/plan', 10)
         self._map_time: float | None = None
+        self._plan_sent: tuple | None = None   # (field, robot position, time) of ~/plan
         self.create_subscription(LaserScan, 'scan', self._on_scan, qos_profile_sensor_data)
         self.create_subscription(Odometry, 'odom', self._on_odom, 10)
         self.create_subscription(PoseStamped, 'goal_pose', self._on_goal, 10)
@@ -207,14 +212,20 @@ class PlannerNode(Node):
         self.status_pub.publish(String(data=decision.text))
 
     def _publish_memory(self, decision, tick) -> None:
-        """~/plan every cycle the field was used; ~/map at most at map_rate."""
+        """~/plan for each new field, and when the robot moved PLAN_SPACING or a second
+        passed (its points PLAN_SPACING apart); ~/map at most at map_rate."""
         if not self.cfg.geodesic:
             return
         frame, now = self.options.odom_frame, tick.nanoseconds * 1e-9
         field = decision.result.field if decision.result is not None else None
         if self.options.publish_plan and field is not None and self.ctl.pose is not None:
-            self.plan_pub.publish(path_to_msg(field.path(self.ctl.pose[:2]), frame,
-                                              tick.to_msg()))
+            here = self.ctl.pose[:2]
+            last = self._plan_sent
+            if last is None or last[0] is not field or now < last[2] or now - last[2] >= 1.0 \
+                    or np.hypot(*(here - last[1])) >= PLAN_SPACING:
+                self._plan_sent = (field, here.copy(), now)
+                self.plan_pub.publish(path_to_msg(
+                    thin_polyline(field.path(here), PLAN_SPACING), frame, tick.to_msg()))
         if self.options.publish_map and (self._map_time is None or now < self._map_time
                                          or now - self._map_time >= 1.0 / self.options.map_rate):
             self._map_time = now
