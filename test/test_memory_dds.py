@@ -4,6 +4,7 @@ memory (~/map) and plan (~/plan) reach other processes with the right types and 
 import subprocess
 import sys
 
+import numpy as np
 import pytest
 import yaml
 
@@ -46,5 +47,13 @@ def test_bringup_drives_a_maze_and_publishes_map_and_plan(tmp_path, bringup_env)
     grid, plan = seen['/subapf_planner/map'][-1], seen['/subapf_planner/plan']
     assert grid.header.frame_id == 'odom' and grid.info.width == grid.info.height == 400
     assert max(grid.data) > 50 and min(grid.data) == -1     # walls seen, much unseen
-    assert len(plan) > 50 and all(p.header.frame_id == 'odom' for p in plan)
-    assert 1 <= len(seen['/subapf_planner/map']) <= len(plan)   # the map at a few Hz at most
+    # a plan per new field, per 0.25 m driven or per second: at least one per 2 s of a
+    # run of 25 s or more; its points 0.25 m apart (the last step may be shorter)
+    assert len(plan) >= 12 and all(p.header.frame_id == 'odom' for p in plan)
+    for p in plan:
+        xy = np.array([(q.pose.position.x, q.pose.position.y) for q in p.poses])
+        assert len(xy) >= 2 and np.all(np.hypot(*np.diff(xy[:-1], axis=0).T) >= 0.25 - 1e-6)
+    # the map at map_rate (1 Hz of the simulated clock) at most
+    stamps = [m.header.stamp.sec + 1e-9 * m.header.stamp.nanosec
+              for m in seen['/subapf_planner/map']]
+    assert len(stamps) >= 1 and np.all(np.diff(stamps) >= 1.0 - 1e-6)
