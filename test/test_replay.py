@@ -114,10 +114,10 @@ def assert_same_answers(over_dds, in_process, share: float = 0.75):
     """Command for command within 1e-9 on at least ``share`` of the ticks; the commands
     vary (the robot drives and turns), so the agreement is no coincidence. The node
     answers every tick but the bag's last command, the zero it published on shutdown,
-    which was no tick of its timer. (Not all: when the node's executor finds a scan and
-    the tick's /clock ready together it may run the timer first, and plan that tick with
-    the previous scan; with two benchmark workers and another DDS test beside it, 106
-    of 125 ticks agreed.)"""
+    which was no tick of its timer. (Not all: a scan still in transit when the tick's
+    /clock arrives is planned a tick late; before the node took in arrived inputs at
+    its tick, with two benchmark workers and another DDS test beside it, 106 of 125
+    ticks agreed.)"""
     a = over_dds.replayed[in_process.skipped:]
     b = in_process.replayed[in_process.skipped:]
     answered = np.isfinite(a).all(axis=1)
@@ -130,9 +130,9 @@ def assert_same_answers(over_dds, in_process, share: float = 0.75):
 @pytest.fixture
 def paper_params(tmp_path) -> Path:
     """config/planner.yaml with the paper's memoryless attraction. Through the node, the
-    default's memory makes a replay depend on the order the node's executor took a tick
-    and a scan that arrived together (README, "Recording and replay"); the paper's
-    method has no memory, so there the node must give exactly what the loop gives."""
+    default's memory carries on the difference a scan still in transit at its tick
+    makes (README, "Recording and replay"); the paper's method has no memory, so
+    there a late scan costs one tick, not the rest of the run."""
     text = PARAMS.read_text()
     assert text.count('attraction_field: geodesic') == 1
     path = tmp_path / 'paper.yaml'

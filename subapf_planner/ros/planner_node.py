@@ -110,8 +110,10 @@ class PlannerNode(Node):
         self.plan_pub = self.create_publisher(Path, '~/plan', 10)
         self._map_time: float | None = None
         self._plan_sent: tuple | None = None   # (field, robot position, time) of ~/plan
-        self.create_subscription(LaserScan, 'scan', self._on_scan, qos_profile_sensor_data)
-        self.create_subscription(Odometry, 'odom', self._on_odom, 10)
+        self._inputs = (
+            (self.create_subscription(LaserScan, 'scan', self._on_scan,
+                                      qos_profile_sensor_data), self._on_scan),
+            (self.create_subscription(Odometry, 'odom', self._on_odom, 10), self._on_odom))
         self.create_subscription(PoseStamped, 'goal_pose', self._on_goal, 10)
 
         self._last_state = ''
@@ -196,9 +198,29 @@ class PlannerNode(Node):
             self.get_logger().info(f'goal ({goal[0]:.2f}, {goal[1]:.2f})')
 
     # --- the planning cycle -----------------------------------------------------------
+    def _take_arrived_inputs(self, tick_ns: int) -> list:
+        """Scans and odometry that have arrived but that the executor has not handed over
+        yet (it runs a ready timer first): those stamped at or before the tick are taken
+        in now, as a replay of the recording orders them; later ones are returned, to be
+        taken in after the tick."""
+        later = []
+        for sub, handler in self._inputs:
+            with sub.handle:
+                while (taken := sub.handle.take_message(sub.msg_type, sub.raw)) is not None:
+                    msg = taken[0]
+                    stamp = msg.header.stamp
+                    if stamp.sec * 1_000_000_000 + stamp.nanosec <= tick_ns:
+                        handler(msg)
+                    else:
+                        later.append((handler, msg))
+        return later
+
     def _on_timer(self) -> None:
         tick = self.get_clock().now()
+        later = self._take_arrived_inputs(tick.nanoseconds)
         decision = self.ctl.tick(tick.nanoseconds * 1e-9)
+        for handler, msg in later:
+            handler(msg)
         if decision.command is not None:   # the command first, stamped with the tick time
             self._publish_cmd(*decision.command, stamp=tick.to_msg())
         if decision.result is not None and self.options.publish_markers:
