@@ -156,7 +156,7 @@ class NavigationField:
         return out
 
     @cached_property
-    def _single_directions(self) -> dict[bytes | None, NDArray[np.float64]]:
+    def _single_directions(self) -> dict[bytes, NDArray[np.float64]]:
         """The last few single-point directions (a cycle asks for the robot's twice)."""
         return {}
 
