@@ -28,6 +28,7 @@ from rclpy.duration import Duration
 from rclpy.exceptions import ParameterException
 from rclpy.node import Node
 from rclpy.qos import qos_profile_sensor_data
+from rclpy.time import Time
 from sensor_msgs.msg import LaserScan
 from std_msgs.msg import String
 from visualization_msgs.msg import MarkerArray
@@ -54,8 +55,10 @@ NODE_NAME = 'subapf_planner'
 #: A forward clock jump longer than this, or any backward one, resets the inputs [s].
 CLOCK_JUMP = 1.0
 #: Points of ~/plan are this far apart, and it is sent again when the robot moved this
-#: far (or for a new field, or after a second) [m].
+#: far, for a new field, or PLAN_PERIOD after the last one [m].
 PLAN_SPACING = 0.25
+#: Longest time between two ~/plan messages while the field is used [s].
+PLAN_PERIOD = 1.0
 
 
 
@@ -208,8 +211,7 @@ class PlannerNode(Node):
             with sub.handle:
                 while (taken := sub.handle.take_message(sub.msg_type, sub.raw)) is not None:
                     msg = taken[0]
-                    stamp = msg.header.stamp
-                    if stamp.sec * 1_000_000_000 + stamp.nanosec <= tick_ns:
+                    if Time.from_msg(msg.header.stamp).nanoseconds <= tick_ns:
                         handler(msg)
                     else:
                         later.append((handler, msg))
@@ -234,7 +236,7 @@ class PlannerNode(Node):
         self.status_pub.publish(String(data=decision.text))
 
     def _publish_memory(self, decision, tick) -> None:
-        """~/plan for each new field, and when the robot moved PLAN_SPACING or a second
+        """~/plan for each new field, and when the robot moved PLAN_SPACING or PLAN_PERIOD
         passed (its points PLAN_SPACING apart); ~/map at most at map_rate."""
         if not self.cfg.geodesic:
             return
@@ -243,7 +245,8 @@ class PlannerNode(Node):
         if self.options.publish_plan and field is not None and self.ctl.pose is not None:
             here = self.ctl.pose[:2]
             last = self._plan_sent
-            if last is None or last[0] is not field or now < last[2] or now - last[2] >= 1.0 \
+            if last is None or last[0] is not field or now < last[2] \
+                    or now - last[2] >= PLAN_PERIOD \
                     or np.hypot(*(here - last[1])) >= PLAN_SPACING:
                 self._plan_sent = (field, here.copy(), now)
                 self.plan_pub.publish(path_to_msg(
