@@ -32,9 +32,8 @@ PARAMS = REPO / 'config' / 'planner.yaml'
 
 TIERS = ('core', 'sim', 'node', 'dds', 'slow')
 #: A test without a tier marker fails collection (pytest.UsageError) when True, only
-#: warns when False. Flip to True once every test module has its ``pytestmark``;
-#: SUBAPF_REQUIRE_TIERS=1 or =0 in the environment overrides it.
-REQUIRE_TIERS = False
+#: warns when False; SUBAPF_REQUIRE_TIERS=1 or =0 in the environment overrides it.
+REQUIRE_TIERS = True
 
 #: Domains leased to DDS tests and the session: above the 1-100 that subapf-bringup,
 #: subapf-replay and subapf-nodeperf pick at random when given no --domain-id, and at

@@ -32,13 +32,14 @@ def test_short_bench_writes_consistent_results(tmp_path, worlds_dir):
     assert doc['methods'] == ['subharmonic_sampling:geodesic', 'dwa:euclidean']
     for r in runs:
         assert KEYS <= set(r)
-        assert r['outcome'] in ('reached', 'collision', 'timeout', 'abandoned')
-        if r['outcome'] == 'reached':
-            assert r['final_distance'] <= r['goal_tolerance']
-            straight = 5.0 if r['world'] == 'four_points' else 4.0
-            assert r['path_length'] >= straight - r['goal_tolerance'] - 0.05
-        if r['outcome'] == 'collision':
-            assert r['min_clearance'] <= 0.01
+        # both planners pass both open worlds (README, shipped-world table), without
+        # touching anything, and the run's record agrees with itself
+        assert r['outcome'] == 'reached', r
+        assert r['final_distance'] <= r['goal_tolerance']
+        straight = 5.0 if r['world'] == 'four_points' else 4.0
+        assert r['path_length'] >= straight - r['goal_tolerance'] - 0.05
+        assert r['min_clearance'] > 0.1
+        assert r['time_s'] == pytest.approx(r['cycles'] * PAPER.period, abs=PAPER.period)
         assert r['cycles'] >= 1 and r['plan_ms_p99'] >= r['plan_ms_median'] > 0
     assert (out / 'summary.md').read_text().startswith('| method |')
     assert (out / 'four_points.png').stat().st_size > 10_000

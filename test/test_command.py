@@ -7,6 +7,7 @@ import pytest
 
 from subapf_planner.core.command import forward_blocked, shape_command
 from subapf_planner.core.config import PlannerConfig
+from subapf_planner.core.planner import plan
 
 pytestmark = pytest.mark.core
 
@@ -14,8 +15,19 @@ CFG = PlannerConfig()
 NONE = np.zeros((0, 2))
 
 
-def test_goal_reached_and_no_safe_move_stop():
-    assert shape_command((0, 0, 0), (1, 0), (0.1, 0), (0.2, 0), NONE, CFG).status == 'reached'
+def test_goal_reached_is_a_gate_before_the_command():
+    """Within the tolerance the planner stops with ``reached`` whatever the obstacles (the
+    goal gate, core/planner.py), even with a laser point on the goal itself."""
+    for obstacles in (NONE, np.array([[0.1, 0.0]])):
+        r = plan(CFG, (0, 0, 0), (0.1, 0), obstacles, (0.2, 0))
+        assert (r.command.v, r.command.w, r.command.status) == (0.0, 0.0, 'reached')
+    # just outside it the same goal is driven to, or refused when a point lies on it
+    assert plan(CFG, (0, 0, 0), (0.16, 0), NONE, (0.2, 0)).command.status == 'driving'
+    assert plan(CFG, (0, 0, 0), (0.16, 0), np.array([[0.16, 0.0]])).command.status == \
+        'goal_in_obstacle'
+
+
+def test_no_safe_move_stops():
     c = shape_command((0, 0, 0), None, (3, 0), (0.2, 0.5), NONE, CFG)
     assert (c.v, c.w, c.status) == (0.0, 0.0, 'no_safe_move')
 

@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 
 from subapf_planner.core.occupancy import OccupancyGrid
+from subapf_planner.core.scan import Scan
 from subapf_planner.ros.conversions import (
     cmd_from_msg,
     cmd_to_msg,
@@ -53,6 +54,6 @@ def test_round_trips():
     pose = np.array([1.0, -2.0, 2.5])
     np.testing.assert_allclose(pose_from_odom(odom_to_msg(pose, (0.0, 0.0), 3.0)), pose)
     ranges = np.array([1.0, np.inf, np.nan, 0.0])
-    scan = scan_from_msg(scan_to_msg(ranges, -0.1, 0.01, 0.12, 3.5, 4.0, 'base_scan'))
+    scan = scan_from_msg(scan_to_msg(Scan(ranges, -0.1, 0.01, 0.12, 3.5, 4.0), 'base_scan'))
     np.testing.assert_array_equal(scan.ranges, ranges.astype(np.float32))
     assert scan.stamp == pytest.approx(4.0) and scan.angle_increment == pytest.approx(0.01)

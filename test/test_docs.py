@@ -12,9 +12,6 @@ import pytest
 
 pytestmark = pytest.mark.core
 
-#: Required by the navigation-function feature being built (core/navigation.py), which
-#: may not be committed yet; empty this once it is.
-PLANNED = {'scipy', 'scikit-fmm'}
 #: package.xml's rosdep keys for PyPI distributions.
 ROSDEP_KEYS = {'python3-numpy': 'numpy', 'python3-scipy': 'scipy', 'python3-yaml': 'pyyaml',
                'python3-matplotlib': 'matplotlib', 'python3-tqdm': 'tqdm'}
@@ -99,7 +96,7 @@ def test_install_requires_is_what_the_code_imports_minus_ros():
         needed |= {d.lower().replace('_', '-') for d in dists[module]}
     required = {dist_name(r) for r in setup_literal('INSTALL_REQUIRES')}
     assert not any(is_ros(r.replace('-', '_')) or r.startswith('ros-') for r in required)
-    assert needed <= required and required - needed <= PLANNED
+    assert needed == required
 
 
 def test_workspace_instructions_install_every_non_ros_dependency_once():

@@ -11,6 +11,7 @@ from rclpy.executors import SingleThreadedExecutor
 from rclpy.parameter import Parameter
 
 from subapf_planner.core.config import PlannerConfig
+from subapf_planner.core.scan import Scan
 from subapf_planner.ros.conversions import odom_to_msg, scan_to_msg
 from subapf_planner.ros.planner_node import PlannerNode
 from subapf_planner.sim.episode import run_episode
@@ -71,10 +72,10 @@ def node_and_clock():
 @pytest.mark.parametrize('stream', ['scan', 'odom'])
 def test_stale_input_stops_within_one_period_of_its_timeout(stream):
     """The controller on a 5 Hz tick: zero velocity at the first tick past the timeout."""
-    from subapf_planner.core.controller import PlannerController, ScanInput, Supervision
-    ctl = PlannerController(PlannerConfig(), Supervision(scan_timeout=0.5, odom_timeout=0.5))
+    from subapf_planner.core.loop import DecisionLoop, Supervision
+    ctl = DecisionLoop(PlannerConfig(), Supervision(scan_timeout=0.5, odom_timeout=0.5))
     ctl.set_goal(np.array([3.0, 0.0]))
-    scan = ScanInput(np.full(360, np.inf), 0.0, math.pi / 180, 0.12, 3.5, 0.0)
+    scan = Scan(np.full(360, np.inf), 0.0, math.pi / 180, 0.12, 3.5, 0.0)
     last_input, first_stop = 1.0, None
     for k in range(1, 20):
         t = 0.2 * k
@@ -100,7 +101,7 @@ def test_stream_stops_then_resumes(node_and_clock, stream):
     sent = []
     node._publish_cmd = lambda v, w, stamp=None: sent.append((time.monotonic(), v, w))
     node._set_goal(np.array([3.0, 0.0]))
-    scan = scan_to_msg(np.full(360, np.inf), 0.0, math.pi / 180, 0.12, 3.5, 0.0, 'base_scan')
+    scan = scan_to_msg(Scan(np.full(360, np.inf), 0.0, math.pi / 180, 0.12, 3.5, 0.0), 'base_scan')
     last_input = {'t': 0.0}
 
     def feed(scan_on=True, odom_on=True):
@@ -125,7 +126,7 @@ def test_stream_stops_then_resumes(node_and_clock, stream):
     run(1.5, **off)
     stops = [t for t, v, w in sent if t > last_input['t'] and v == 0.0 and w == 0.0]
     assert stops, 'no zero command after the stream stopped'
-    assert stops[0] - last_input['t'] <= 0.5 + 3 * node.cfg.period
+    assert stops[0] - last_input['t'] <= 0.5 + 3 * node.ctl.cfg.period
     assert node.ctl.text == f'stopped: {"scan" if stream == "scan" else "odometry"} is stale'
     assert all(v == 0.0 for t, v, _ in sent if t > stops[0])
     run(1.0)
@@ -133,10 +134,10 @@ def test_stream_stops_then_resumes(node_and_clock, stream):
 
 
 def test_clock_jump_resets_inputs_but_keeps_the_goal():
-    from subapf_planner.core.controller import PlannerController, ScanInput
-    ctl = PlannerController(PlannerConfig())
+    from subapf_planner.core.loop import DecisionLoop
+    ctl = DecisionLoop(PlannerConfig())
     ctl.set_goal(np.array([3.0, 0.0]))
-    ctl.update_scan(ScanInput(np.full(360, np.inf), 0.0, math.pi / 180, 0.12, 3.5, 50.0), 50.0)
+    ctl.update_scan(Scan(np.full(360, np.inf), 0.0, math.pi / 180, 0.12, 3.5, 50.0), 50.0)
     ctl.update_odom(50.0, np.zeros(3), 50.0)
     assert ctl.tick(50.0).command[0] > 0
     ctl.clock_jumped()

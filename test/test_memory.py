@@ -12,6 +12,7 @@ from subapf_planner.core.memory import NavigationMemory
 from subapf_planner.core.navigation import NEIGHBOURS, compute_field, thin_polyline
 from subapf_planner.core.occupancy import LOG_ODDS_MAX, OccupancyGrid
 from subapf_planner.core.planner import Planner
+from subapf_planner.core.scan import Scan
 from subapf_planner.core.status import Status
 
 pytestmark = pytest.mark.core
@@ -20,7 +21,7 @@ RES = 0.05
 
 
 def one_beam(grid, r, yaw=0.0, origin=(0.0, 0.0)):
-    grid.update([r], 0.0, 0.01, 0.12, 3.5, (origin[0], origin[1], yaw))
+    grid.update(Scan([r], 0.0, 0.01, 0.12, 3.5), (origin[0], origin[1], yaw))
 
 
 def test_a_beam_marks_its_end_and_clears_what_it_crossed():
@@ -46,7 +47,7 @@ def test_invalid_returns_change_nothing(bad):
 def test_open_beam_clears_up_to_its_range():
     grid = OccupancyGrid(RES, 10.0)
     grid.log_odds[:] = 0.5
-    grid.update([math.inf], 0.0, 0.01, 0.12, 3.5, (0.0, 0.0, 0.0), clear_range=2.0)
+    grid.update(Scan([math.inf], 0.0, 0.01, 0.12, 3.5), (0.0, 0.0, 0.0), clear_range=2.0)
     assert grid.log_odds[tuple(grid.cell_of([1.9, 0.0])[0])] < 0.5
     assert grid.log_odds[tuple(grid.cell_of([2.2, 0.0])[0])] == 0.5
 
@@ -71,7 +72,7 @@ def test_memory_stays_bounded_on_a_long_drive():
     for k in range(400):                      # 200 m straight, scanning all the way
         x = 0.5 * k
         grid.follow((x, 0.0))
-        grid.update(ranges, 0.0, 2 * math.pi / 360, 0.12, 3.5, (x, 0.0, 0.0))
+        grid.update(Scan(ranges, 0.0, 2 * math.pi / 360, 0.12, 3.5), (x, 0.0, 0.0))
         robot = grid.cell_of([x, 0.0])[0]
         assert grid.inside(robot[None])[0]
     assert grid.nbytes == size == 400 * 400 * 4
@@ -203,12 +204,12 @@ def test_planner_stops_for_an_enclosed_goal_and_drives_when_it_opens():
     ranges = ranges.copy()
     goal = (2.0, 0.0)                            # outside a closed ring of radius ~1 m
     for k in range(3):
-        res = planner.step_scan(pose, goal, ranges, amin, inc, rmin, rmax, stamp=k, now=k)
+        res = planner.step(pose, goal, Scan(ranges, amin, inc, rmin, rmax, k), now=k)
     assert res.command.status is Status.GOAL_UNREACHABLE and res.command.v == 0.0
     ranges[-30:] = np.inf                        # an opening appears (and stays)
     ranges[:30] = np.inf
     for k in range(3, 12):
-        res = planner.step_scan(pose, goal, ranges, amin, inc, rmin, rmax, stamp=k, now=k)
+        res = planner.step(pose, goal, Scan(ranges, amin, inc, rmin, rmax, k), now=k)
     assert res.command.status is not Status.GOAL_UNREACHABLE
 
 
@@ -216,18 +217,18 @@ def test_memory_recomputes_on_a_new_goal_and_at_most_every_field_period():
     cfg = PlannerConfig(field_period=1.0)
     mem = NavigationMemory(cfg)
     ranges, amin, inc, rmin, rmax = enclosure_scan(2.0)
-    mem.integrate(ranges, amin, inc, rmin, rmax, (0.0, 0.0, 0.0), 0.0)
+    mem.integrate(Scan(ranges, amin, inc, rmin, rmax, 0.0), (0.0, 0.0, 0.0))
     mem.field_for((0, 0), (1.0, 0.0), now=0.0)
     assert mem.recomputed
-    mem.integrate(*enclosure_scan(1.5), (0.0, 0.0, 0.0), 0.2)
+    mem.integrate(Scan(*enclosure_scan(1.5), 0.2), (0.0, 0.0, 0.0))
     mem.field_for((0, 0), (1.0, 0.0), now=0.2)
     assert not mem.recomputed                    # grid changed, but within field_period
     mem.field_for((0, 0), (0.0, 1.0), now=0.4)
     assert mem.recomputed                        # new goal
-    mem.integrate(*enclosure_scan(1.2), (0.0, 0.0, 0.0), 1.5)
+    mem.integrate(Scan(*enclosure_scan(1.2), 1.5), (0.0, 0.0, 0.0))
     mem.field_for((0, 0), (0.0, 1.0), now=1.5)
     assert mem.recomputed                        # grid changed, field_period over
-    mem.integrate(*enclosure_scan(1.2), (0.0, 0.0, 0.0), 3.0)
+    mem.integrate(Scan(*enclosure_scan(1.2), 3.0), (0.0, 0.0, 0.0))
     mem.field_for((0, 0), (0.0, 1.0), now=3.0)
     assert not mem.recomputed                    # the same walls seen again: no change
 

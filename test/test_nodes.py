@@ -14,6 +14,7 @@ from rclpy.qos import qos_profile_sensor_data
 from sensor_msgs.msg import LaserScan
 from std_msgs.msg import String
 
+from subapf_planner.core.scan import Scan
 from subapf_planner.ros.conversions import odom_to_msg, scan_to_msg
 from subapf_planner.ros.planner_node import PlannerNode
 from subapf_planner.ros.qos import LATCHED as LATCHED_QOS
@@ -62,7 +63,7 @@ class Harness:
         t = self.node.get_clock().now().nanoseconds * 1e-9
         if scan:
             ranges = np.full(360, np.inf) if ranges is None else ranges
-            self.scan_pub.publish(scan_to_msg(ranges, 0.0, math.pi / 180, 0.12, 3.5, t,
+            self.scan_pub.publish(scan_to_msg(Scan(ranges, 0.0, math.pi / 180, 0.12, 3.5, t),
                                               'base_scan'))
         if odom:
             self.odom_pub.publish(odom_to_msg(np.array(pose), (0.0, 0.0), t))
@@ -116,15 +117,15 @@ def test_runtime_parameter_changes_are_validated(harness):
     assert not bad.successful and 'method' in bad.reason
     assert node.get_parameter('method').value == 'subharmonic_sampling'
     ok = node.set_parameters([Parameter('method', value='harmonic')])[0]
-    assert ok.successful and node.cfg.method == 'harmonic'
+    assert ok.successful and node.ctl.cfg.method == 'harmonic'
 
 
 def test_no_command_before_scan_and_odom_then_drives(harness):
     h = harness()
     h.goal(2.0, 0.0)
-    h.spin_until(lambda: False, timeout=0.5)
+    # three ticks with the goal but no inputs: each says why it waits, none commands
+    assert h.spin_until(lambda: sum(s.startswith('waiting') for s in h.states) >= 3)
     assert h.cmds == []
-    assert any(s.startswith('waiting') for s in h.states)
     assert h.spin_until(lambda: (h.feed(), any(c.twist.linear.x > 0 for c in h.cmds))[1])
     assert all(isinstance(c, TwistStamped) for c in h.cmds)
 
@@ -150,8 +151,11 @@ def test_goal_reached_gives_zero_velocity(harness):
 def test_goal_in_another_frame_is_refused(harness):
     h = harness()
     h.goal(2.0, 0.0, frame='map')
-    h.spin_until(lambda: (h.feed(), False)[1], timeout=0.6)
+    # three ticks with fresh inputs after the refused goal: still idle, no command
+    assert h.spin_until(lambda: (h.feed(), h.states.count('idle: no goal') >= 3)[1])
     assert h.node.ctl.goal is None and h.cmds == []
+    h.goal(2.0, 0.0)   # the same goal in odom is taken
+    assert h.spin_until(lambda: (h.feed(), any(c.twist.linear.x > 0 for c in h.cmds))[1])
 
 
 def test_twist_when_stamped_disabled(harness):

@@ -15,9 +15,9 @@ from sensor_msgs.msg import LaserScan
 
 from subapf_planner.core.command import forward_blocked
 from subapf_planner.core.config import METHODS, PlannerConfig
-from subapf_planner.core.controller import PlannerController, ScanInput
+from subapf_planner.core.loop import DecisionLoop
 from subapf_planner.core.planner import Planner, plan
-from subapf_planner.core.scan import geometry_warning
+from subapf_planner.core.scan import Scan, geometry_warning
 from subapf_planner.ros.planner_node import PlannerNode
 
 pytestmark = pytest.mark.node
@@ -54,7 +54,7 @@ def test_fuzz_core_plan(method, x, y, yaw, gx, gy, obstacles, v0, w0):
        angle_min=weird, inc=weird, rmin=weird, rmax=weird, pose=st.tuples(coord, coord, weird))
 @settings(max_examples=1000, deadline=None)
 def test_fuzz_core_scans(ranges, angle_min, inc, rmin, rmax, pose):
-    result = Planner(CFG).step_scan(pose, (2.0, 2.0), ranges, angle_min, inc, rmin, rmax)
+    result = Planner(CFG).step(pose, (2.0, 2.0), Scan(ranges, angle_min, inc, rmin, rmax))
     check_command(result.command, pose, result.obstacles)
 
 
@@ -77,7 +77,7 @@ class Captured:
 
     def __init__(self, node):
         self.node, self.cmds, self.decisions = node, [], []
-        node.ctl = PlannerController(node.cfg, node.ctl.limits)
+        node.ctl = DecisionLoop(node.ctl.cfg, node.ctl.limits)
         node._publish_cmd = lambda v, w, stamp=None: self.cmds.append((v, w))
         tick = node.ctl.tick
 
@@ -173,11 +173,18 @@ def test_nan_angle_min_with_finite_angle_max_stops(node):
 
 
 def test_length_mismatch_and_intensities_do_not_matter(node):
-    msg = scan_msg(FREE, 0.0, math.pi / 180, 0.12, 3.5, 'base_scan', angle_max=1.0)
+    """A header whose angle_max does not match the ranges (and stray intensities) is used
+    with beam i at angle_min + i * increment: the same decision as a consistent header."""
+    ranges = list(FREE)
+    ranges[20:30] = [0.5] * 10   # a wall to the front left bends the path
+    good = drive(node, scan_msg(ranges, 0.0, math.pi / 180, 0.12, 3.5, 'base_scan'))
+    msg = scan_msg(ranges, 0.0, math.pi / 180, 0.12, 3.5, 'base_scan', angle_max=1.0)
     msg.intensities = [1.0, 2.0]
     assert geometry_warning(360, 0.0, 1.0, math.pi / 180) is not None
     d = drive(node, msg)
-    assert d.text.startswith('driving') and d.command[0] >= 0.0
+    assert d.text == good.text and d.text.startswith('driving')
+    assert d.command == good.command and good.command[1] < 0.0   # turns right, away
+    np.testing.assert_array_equal(d.result.obstacles, good.result.obstacles)
 
 
 def test_all_inf_and_empty_scans_are_open_space(node):
@@ -208,7 +215,7 @@ def test_nan_pose_dropped_and_quaternion_normalised(node):
 
 
 def test_odometry_time_going_back_clears_history():
-    ctl = PlannerController(CFG)
+    ctl = DecisionLoop(CFG)
     assert ctl.update_odom(5.0, np.zeros(3), 5.0)
     assert not ctl.update_odom(1.0, np.ones(3), 5.1)
     assert len(ctl.poses) == 1
@@ -222,20 +229,20 @@ def test_bad_goals_are_refused(node, goal, frame):
 
 
 def test_goal_inside_obstacle_stops_with_reason():
-    ctl = PlannerController(CFG)
+    ctl = DecisionLoop(CFG)
     ctl.set_goal(np.array([1.0, 0.0]))
     ranges = np.full(360, np.inf)
     ranges[0] = 1.032   # a return exactly at the goal
-    ctl.update_scan(ScanInput(ranges, 0.0, math.pi / 180, 0.12, 3.5, 0.0), 0.0)
+    ctl.update_scan(Scan(ranges, 0.0, math.pi / 180, 0.12, 3.5, 0.0), 0.0)
     ctl.update_odom(0.0, np.zeros(3), 0.0)
     d = ctl.tick(0.0)
     assert d.command == (0.0, 0.0) and d.text == 'stopped: goal_in_obstacle'
 
 
 def test_goal_equal_to_start_is_reached_at_once():
-    ctl = PlannerController(CFG)
+    ctl = DecisionLoop(CFG)
     ctl.set_goal(np.array([0.0, 0.0]))
-    ctl.update_scan(ScanInput(np.full(360, np.inf), 0.0, math.pi / 180, 0.12, 3.5, 0.0), 0.0)
+    ctl.update_scan(Scan(np.full(360, np.inf), 0.0, math.pi / 180, 0.12, 3.5, 0.0), 0.0)
     ctl.update_odom(0.0, np.zeros(3), 0.0)
     assert ctl.tick(0.0).text.startswith('reached') and ctl.goal is None
 
@@ -243,14 +250,14 @@ def test_goal_equal_to_start_is_reached_at_once():
 def test_goal_behind_a_wall_without_progress_becomes_stuck():
     """The paper's traditional field in front of a wall it cannot pass: the robot (odometry
     fixed, as if pushing) makes no progress, and the progress checker gives the goal up."""
-    ctl = PlannerController(CFG.replace(method='traditional', attraction_field='euclidean'))
+    ctl = DecisionLoop(CFG.replace(method='traditional', attraction_field='euclidean'))
     ctl.limits = type(ctl.limits)(progress_timeout=2.0)
     ctl.set_goal(np.array([0.0, 3.0]))
     ranges = np.full(360, np.inf)
     a = np.radians(np.arange(360))
     ahead = np.abs(np.remainder(a + np.pi, 2 * np.pi) - np.pi) < 1.2    # a wall 1 m ahead
     ranges[ahead] = 1.0 / np.cos(a[ahead])
-    scan = ScanInput(ranges, 0.0, math.pi / 180, 0.12, 3.5, 0.0)
+    scan = Scan(ranges, 0.0, math.pi / 180, 0.12, 3.5, 0.0)
     states = []
     for k in range(20):   # the robot does not move (pose fixed): no progress
         ctl.update_scan(scan, 0.2 * k)

@@ -12,10 +12,10 @@ from subapf_planner.bag.events import PLAIN_CMD, events
 from subapf_planner.bag.reader import BagError, read, topics
 from subapf_planner.bag.writer import McapRecorder
 from subapf_planner.core.config import load_config
-from subapf_planner.core.controller import Supervision
+from subapf_planner.core.loop import Supervision
+from subapf_planner.ros.replay import replay
 from subapf_planner.ros.replay_dds import replay_through_node
 from subapf_planner.tools.replay import main as replay_main
-from subapf_planner.tools.replay import replay
 
 pytestmark = pytest.mark.node
 

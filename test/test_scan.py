@@ -8,7 +8,13 @@ from hypothesis.extra.numpy import arrays
 import numpy as np
 import pytest
 
-from subapf_planner.core.scan import ScanError, scan_to_points, valid_beams, voxel_downsample
+from subapf_planner.core.scan import (
+    Scan,
+    ScanError,
+    scan_to_points,
+    valid_beams,
+    voxel_downsample,
+)
 
 pytestmark = pytest.mark.core
 
@@ -20,7 +26,7 @@ ranges_st = arrays(np.float64, st.integers(0, 500),
 @given(r=ranges_st)
 @settings(max_examples=300, deadline=None)
 def test_only_valid_returns_become_points(r):
-    pts = scan_to_points(r, 0.0, 2 * math.pi / max(len(r), 1), 0.12, 3.5, (1.0, -2.0, 0.3))
+    pts = scan_to_points(Scan(r, 0.0, 2 * math.pi / max(len(r), 1), 0.12, 3.5), (1.0, -2.0, 0.3))
     expected = np.sum(np.isfinite(r) & (r >= 0.12) & (r < 3.5))
     assert pts.shape == (expected, 2)
     assert np.all(np.isfinite(pts))
@@ -37,21 +43,23 @@ def test_lds01_zero_and_lds02_nan_are_dropped():
 
 def test_geometry_with_pose_and_laser_offset():
     # one beam straight ahead at 1 m, laser 0.1 m behind the base, robot at (2, 3) facing +y
-    pts = scan_to_points([1.0], 0.0, 0.01, 0.1, 3.5, (2.0, 3.0, math.pi / 2), (-0.1, 0.0, 0.0))
+    pts = scan_to_points(Scan([1.0], 0.0, 0.01, 0.1, 3.5), (2.0, 3.0, math.pi / 2),
+                         (-0.1, 0.0, 0.0))
     np.testing.assert_allclose(pts, [[2.0, 3.9]], atol=1e-12)
     # beam at +90 deg in a laser yawed by pi
-    pts = scan_to_points([0.0, 1.0], 0.0, math.pi / 2, 0.1, 3.5, (0, 0, 0), (0, 0, math.pi))
+    pts = scan_to_points(Scan([0.0, 1.0], 0.0, math.pi / 2, 0.1, 3.5), (0, 0, 0),
+                         (0, 0, math.pi))
     np.testing.assert_allclose(pts, [[0.0, -1.0]], atol=1e-12)
 
 
 def test_empty_scan_and_bad_geometry():
-    assert scan_to_points([], 0.0, 0.0, 0.1, 3.5, (0, 0, 0)).shape == (0, 2)
+    assert scan_to_points(Scan([], 0.0, 0.0, 0.1, 3.5), (0, 0, 0)).shape == (0, 2)
     with pytest.raises(ScanError, match='angle_increment'):
-        scan_to_points([1.0, 1.0], 0.0, 0.0, 0.1, 3.5, (0, 0, 0))
+        scan_to_points(Scan([1.0, 1.0], 0.0, 0.0, 0.1, 3.5), (0, 0, 0))
     with pytest.raises(ScanError, match='angle_increment'):
-        scan_to_points([1.0, 1.0], 0.0, -0.1, 0.1, 3.5, (0, 0, 0))
+        scan_to_points(Scan([1.0, 1.0], 0.0, -0.1, 0.1, 3.5), (0, 0, 0))
     with pytest.raises(ScanError, match='non-finite'):
-        scan_to_points([1.0], math.nan, 0.1, 0.1, 3.5, (0, 0, 0))
+        scan_to_points(Scan([1.0], math.nan, 0.1, 0.1, 3.5), (0, 0, 0))
 
 
 def test_voxel_downsample_bounds_wall_density():

@@ -5,7 +5,7 @@ import math
 import numpy as np
 import pytest
 
-from subapf_planner.sim.simulator import LASER_OFFSET, BurgerSim, SimConfig
+from subapf_planner.sim.simulator import ROBOT, BurgerSim, SimConfig
 from subapf_planner.sim.world import parse_world
 
 pytestmark = pytest.mark.sim
@@ -40,7 +40,7 @@ def test_lidar_range_to_known_box():
     box = {'box': {'center': [2.0, 0.0], 'size': [0.2, 2.0]}}
     with BurgerSim(world([box]), SimConfig(range_noise=0.0)) as sim:
         scan = sim.scan()
-    face = 2.0 - 0.1 - LASER_OFFSET[0]
+    face = 2.0 - 0.1 - ROBOT.laser.x
     assert scan.ranges[0] == pytest.approx(face, abs=1e-3)
     # beam 10 deg off axis hits the same plane at face / cos(10 deg)
     assert scan.ranges[10] == pytest.approx(face / math.cos(math.radians(10)), abs=2e-3)

@@ -1,6 +1,6 @@
 """A recorded run as one time-ordered stream of planner inputs and commands.
 
-Both replays (in-process, tools/replay.py, and through a planner_node over DDS,
+Both replays (in-process, ros/replay.py, and through a planner_node over DDS,
 ros/replay_dds.py) read a bag through :func:`events`, so they see the same
 events at the same simulated times in the same order:
 

@@ -1,12 +1,14 @@
 """Command shaping for a differential drive: next move point -> (v, w).
 
-Defaults are the TurtleBot3 burger's limits (0.22 m/s, 2.84 rad/s).
-Order of rules: goal reached -> stop; no safe point -> stop; heading error
-beyond ``rotate_in_place_angle`` -> turn on the spot; otherwise drive at the
-speed that covers the step in one planning period, scaled by cos(heading error)
-and slowed inside ``slowdown_distance`` of the goal; then acceleration limits;
-last, the safety corridor zeroes forward speed while an obstacle point is
-ahead within the danger distance. Stops are immediate (not rate limited).
+Defaults are the TurtleBot3 burger's limits (0.22 m/s, 2.84 rad/s); the goal
+gates (reached, inside an obstacle) come before this (core/planner.py).
+Order of rules: no safe point -> stop; heading error beyond
+``rotate_in_place_angle`` -> turn on the spot; otherwise drive at the speed
+that covers the step in one planning period, scaled by cos(heading error) and
+slowed inside ``slowdown_distance`` of the goal; then acceleration limits;
+last, the safety corridor zeroes forward speed while an obstacle point lies
+ahead, within ``robot_radius`` of the heading line and closer than
+``safety_distance`` to the centre. Stops are immediate (not rate limited).
 """
 
 from __future__ import annotations
@@ -64,12 +66,11 @@ def _rate_limit(value: float, previous: float, max_rate: float, dt: float) -> fl
 def shape_command(pose: ArrayLike, target: ArrayLike | None, goal: ArrayLike,
                   previous: tuple[float, float], obstacles: ArrayLike,
                   cfg: PlannerConfig) -> Command:
-    """(v, w) that moves the robot at ``pose`` (x, y, yaw) towards ``target``."""
+    """(v, w) that moves the robot at ``pose`` (x, y, yaw) towards ``target`` (None: no
+    safe point, a stop), slowing down near ``goal``; ``previous`` is the last (v, w)."""
     x, y, yaw = (float(v) for v in pose)
     gx, gy = (float(v) for v in goal)
     dist_goal = math.hypot(gx - x, gy - y)
-    if dist_goal <= cfg.goal_tolerance:
-        return Command(0.0, 0.0, Status.REACHED)
     if target is None:
         return Command(0.0, 0.0, Status.NO_SAFE_MOVE)
     tx, ty = (float(v) for v in target)

@@ -17,6 +17,7 @@ from typing import Any, Mapping
 import yaml
 
 from .params import ConfigError, build, check_fields, param
+from .robot import BURGER, RobotDescription
 
 #: Repulsive potentials of the paper, plus the Dynamic Window baseline.
 APF_METHODS = ('subharmonic_sampling', 'subharmonic', 'traditional', 'harmonic')
@@ -65,13 +66,18 @@ class PlannerConfig:
                                'm', 0.0, 1.0)
     obstacle_range: float = param(3.5, 'Laser returns beyond this are ignored', 'm',
                                    0.1, 100.0)
-    laser_x: float = param(-0.032, 'Laser position in base_footprint (x)', 'm', -2.0, 2.0)
-    laser_y: float = param(0.0, 'Laser position in base_footprint (y)', 'm', -2.0, 2.0)
-    laser_yaw: float = param(0.0, 'Laser yaw in base_footprint', 'rad', -math.pi, math.pi)
+    laser_x: float = param(BURGER.laser.x, 'Laser position in base_footprint (x)', 'm',
+                           -2.0, 2.0)
+    laser_y: float = param(BURGER.laser.y, 'Laser position in base_footprint (y)', 'm',
+                           -2.0, 2.0)
+    laser_yaw: float = param(BURGER.laser.yaw, 'Laser yaw in base_footprint', 'rad',
+                             -math.pi, math.pi)
     # --- command shaping (differential drive, TurtleBot3 burger limits) ---------------
     planning_frequency: float = param(5.0, 'Planning rate (paper: 5 Hz)', 'Hz', 0.5, 100.0)
-    max_linear_velocity: float = param(0.22, 'Burger top speed', 'm/s', 0.0, 5.0)
-    max_angular_velocity: float = param(2.84, 'Burger top turn rate', 'rad/s', 0.0, 10.0)
+    max_linear_velocity: float = param(BURGER.max_linear_velocity, 'Top speed', 'm/s',
+                                       0.0, 5.0)
+    max_angular_velocity: float = param(BURGER.max_angular_velocity, 'Top turn rate',
+                                        'rad/s', 0.0, 10.0)
     max_linear_acceleration: float = param(1.0, 'Linear acceleration limit', 'm/s^2',
                                             0.01, 20.0)
     max_angular_acceleration: float = param(3.2, 'Angular acceleration limit', 'rad/s^2',
@@ -82,7 +88,7 @@ class PlannerConfig:
     goal_tolerance: float = param(0.15, 'xy goal tolerance; stop inside it', 'm', 0.01, 5.0)
     slowdown_distance: float = param(0.4, 'Speed scales down linearly inside this distance '
                                       'of the goal', 'm', 0.0, 10.0)
-    robot_radius: float = param(0.105, 'Robot radius: half-width of the forward safety '
+    robot_radius: float = param(BURGER.radius, 'Robot radius: half-width of the forward safety '
                                  'corridor; the field inflates obstacles by it', 'm', 0.0, 2.0)
     safety_distance: float = param(0.18, 'Forward speed is zeroed while an obstacle point '
                                     'lies in the corridor ahead closer than this to the centre '
@@ -94,10 +100,11 @@ class PlannerConfig:
                                   'no local minimum but the goal; the default) or euclidean '
                                   "(the paper's eq. 21 exactly, samples discarded within "
                                   'danger_distance)', choices=('geodesic', 'euclidean'))
-    sample_clearance: float = param(0.135, 'With the geodesic field: samples closer than this '
-                                    'to a laser point are discarded (the paper uses '
-                                    'danger_distance, which closes every gap narrower than '
-                                    '2 d0)', 'm', 0.0, 2.0)
+    sample_clearance: float = param(BURGER.clearance, 'With the geodesic field: samples '
+                                    'closer than this to a laser point are discarded '
+                                    '(robot_radius + 0.03 m; the paper uses danger_distance, '
+                                    'which closes every gap narrower than 2 d0)', 'm',
+                                    0.0, 2.0)
     field_gain: float = param(8.0, 'a_att of the geodesic attraction: a pull of this constant '
                               'magnitude along the field (stronger than the Euclidean one, '
                               "so eq. (13)'s repulsion bends the path but cannot turn it back "
@@ -110,10 +117,11 @@ class PlannerConfig:
                                   'many map cells a side (2: 0.1 m blocks, about five times '
                                   'faster than cells); reachability and inflation stay on '
                                   'the map cells', '', 1, 8)
-    inflation_radius: float = param(0.105, 'Field: cells closer than this to an occupied cell '
-                                    'are in contact (travel there is 50 times slower; a goal '
-                                    'there is unreachable, and so is one that only gaps '
-                                    'narrower than twice this lead to)', 'm', 0.0, 2.0)
+    inflation_radius: float = param(BURGER.radius, 'Field: cells closer than this to an '
+                                    'occupied cell are in contact (travel there is 50 times '
+                                    'slower; a goal there is unreachable, and so is one that '
+                                    'only gaps narrower than twice this lead to)', 'm',
+                                    0.0, 2.0)
     inflation_band: float = param(0.22, 'Field: beyond inflation_radius, travel speeds up '
                                   'linearly to full over this band, so the field keeps to the '
                                   'middle of passages', 'm', 0.0, 2.0)
@@ -121,9 +129,9 @@ class PlannerConfig:
                                 'for a new goal, or when the robot leaves the patch)', 's',
                                 0.0, 60.0)
     # --- DWA baseline (Fox, Burgard, Thrun 1997) ---------------------------------------
-    dwa_clearance: float = param(0.135, 'DWA: arcs passing closer than this to an obstacle '
-                                 'point are inadmissible (robot_radius + 0.03 m)', 'm',
-                                 0.0, 2.0)
+    dwa_clearance: float = param(BURGER.clearance, 'DWA: arcs passing closer than this to an '
+                                 'obstacle point are inadmissible (robot_radius + 0.03 m)',
+                                 'm', 0.0, 2.0)
     dwa_horizon: float = param(2.0, 'DWA rollout horizon', 's', 0.2, 10.0)
     dwa_v_samples: int = param(7, 'DWA linear velocity samples', '', 2, 50)
     dwa_w_samples: int = param(15, 'DWA angular velocity samples', '', 3, 101)
@@ -157,9 +165,27 @@ class PlannerConfig:
         return self.sample_clearance if self.geodesic else self.danger_distance
 
     @property
+    def laser_mount(self) -> tuple[float, float, float]:
+        """(x, y, yaw) of the laser in base_footprint [m, m, rad]."""
+        return (self.laser_x, self.laser_y, self.laser_yaw)
+
+    @property
     def period(self) -> float:
         """Planning period [s]."""
         return 1.0 / self.planning_frequency
+
+    @classmethod
+    def for_robot(cls, robot: RobotDescription, **changes: Any) -> 'PlannerConfig':
+        """The defaults for ``robot``: its footprint, laser mounting and limits, and the
+        clearances derived from its footprint (inflation, samples, DWA); ``changes`` on
+        top (validated)."""
+        mount = robot.laser
+        return from_mapping({
+            'robot_radius': robot.radius, 'inflation_radius': robot.radius,
+            'sample_clearance': robot.clearance, 'dwa_clearance': robot.clearance,
+            'laser_x': mount.x, 'laser_y': mount.y, 'laser_yaw': mount.yaw,
+            'max_linear_velocity': robot.max_linear_velocity,
+            'max_angular_velocity': robot.max_angular_velocity, **changes})
 
     def replace(self, **changes: Any) -> 'PlannerConfig':
         """Copy with some fields changed (validated)."""

@@ -18,17 +18,11 @@ from numpy.typing import ArrayLike
 from .config import PlannerConfig
 from .navigation import NavigationField, compute_field
 from .occupancy import OccupancyGrid
+from .robot import compose
+from .scan import Scan
 
 #: Goals closer than this are the same goal (the field's, the controller's) [m].
 SAME_GOAL = 1e-3
-
-
-def laser_pose(pose: ArrayLike, cfg: PlannerConfig) -> tuple[float, float, float]:
-    """base_scan in odom from base_footprint's odom pose (x, y, yaw) and the mounting."""
-    x, y, yaw = (float(v) for v in pose)
-    c, s = math.cos(yaw), math.sin(yaw)
-    return (x + c * cfg.laser_x - s * cfg.laser_y, y + s * cfg.laser_x + c * cfg.laser_y,
-            yaw + cfg.laser_yaw)
 
 
 class NavigationMemory:
@@ -58,16 +52,15 @@ class NavigationMemory:
         self.field, self._field_key, self._field_time = None, None, -math.inf
         self._scan_stamp = None
 
-    def integrate(self, ranges: ArrayLike, angle_min: float, angle_increment: float,
-                  range_min: float, range_max: float, scan_pose: ArrayLike, stamp: float,
+    def integrate(self, scan: Scan, scan_pose: ArrayLike,
                   goal: ArrayLike | None = None) -> bool:
-        """Add a scan taken from ``scan_pose`` at ``stamp`` [s] unless it was added already."""
-        if self._scan_stamp is not None and stamp == self._scan_stamp:
+        """Add a scan taken with base_footprint at ``scan_pose`` unless the scan with its
+        stamp was added already (a NaN stamp is always new)."""
+        if self._scan_stamp is not None and scan.stamp == self._scan_stamp:
             return False
-        self._scan_stamp = stamp
+        self._scan_stamp = scan.stamp
         self.grid.follow(scan_pose, goal)
-        self.grid.update(ranges, angle_min, angle_increment, range_min, range_max,
-                         laser_pose(scan_pose, self.cfg), self.cfg.obstacle_range)
+        self.grid.update(scan, compose(scan_pose, self.cfg.laser_mount), self.cfg.obstacle_range)
         return True
 
     def _covers(self, position: np.ndarray) -> bool:
@@ -93,8 +86,9 @@ class NavigationMemory:
             return self.field
         cfg = self.cfg
         self.field = compute_field(self.grid.occupied(), self.grid.origin, self.grid.resolution,
-                                   g, p, cfg.inflation_radius, cfg.inflation_band,
-                                   cfg.field_coarsening)
+                                   g, p, inflation_radius=cfg.inflation_radius,
+                                   clearance_band=cfg.inflation_band,
+                                   coarsening=cfg.field_coarsening)
         self._field_key = key
         self._field_time = -math.inf if now is None else now
         self.recomputed = True

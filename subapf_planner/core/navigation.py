@@ -11,11 +11,11 @@ sampling stay as the local layer that keeps the path smooth and clear.
 Computed by fast marching (scikit-fmm, Sethian 1996), which solves the eikonal
 equation |grad T| = 1 / speed and is close to Euclidean (8-connected Dijkstra
 overestimates by up to 8 %). Only occupied cells are walls of the field; the
-speed is ``MIN_SPEED`` within ``robot_radius`` of them (a robot found there is
-led out, not stranded), then rises linearly to 1 at ``robot_radius +
+speed is ``MIN_SPEED`` within ``inflation_radius`` of them (a robot found there is
+led out, not stranded), then rises linearly to 1 at ``inflation_radius +
 clearance_band``: the field keeps to the middle of passages and takes a
 narrow one only when going round costs more. Whether the goal can be reached at
-all is decided on the hard inflation: the free cells at least ``robot_radius``
+all is decided on the hard inflation: the free cells at least ``inflation_radius``
 from every occupied cell, connected (``reachable``). The field is computed on
 the part of the grid that matters: the bounding box of the occupied cells, the
 robot and the goal, grown by ``CROP_MARGIN`` (outside it everything is unknown,
@@ -38,7 +38,9 @@ from numpy.typing import ArrayLike, NDArray
 from scipy import ndimage
 import skfmm
 
-#: Speed within robot_radius of an occupied cell (relative; 1 in open space).
+from .occupancy import cell_index
+
+#: Speed within inflation_radius of an occupied cell (relative; 1 in open space).
 MIN_SPEED = 0.02
 #: Free border kept around the box the field is computed on [m].
 CROP_MARGIN = 1.0
@@ -77,10 +79,10 @@ class NavigationField:
         """Whether the goal can be reached from ``point`` (a cell within ``radius_cells``
         of it is connected to the goal at the hard inflation)."""
         h, w = self.passable.shape
-        c = np.floor((np.asarray(point, float)[:2] - self.origin)
-                     / self.passable_resolution).astype(int)
-        r0, r1 = max(c[1] - radius_cells, 0), min(c[1] + radius_cells + 1, h)
-        c0, c1 = max(c[0] - radius_cells, 0), min(c[0] + radius_cells + 1, w)
+        row, col = cell_index(np.asarray(point, float)[:2], self.origin,
+                              self.passable_resolution)[0]
+        r0, r1 = max(row - radius_cells, 0), min(row + radius_cells + 1, h)
+        c0, c1 = max(col - radius_cells, 0), min(col + radius_cells + 1, w)
         return bool(r0 < r1 and c0 < c1 and self.passable[r0:r1, c0:c1].any())
 
     @cached_property
@@ -162,9 +164,9 @@ class NavigationField:
 
     def _towards_free(self, point: NDArray[np.float64], radius_cells: int = 6) -> NDArray:
         h, wd = self.values.shape
-        c = np.floor((point - self.origin) / self.resolution).astype(int)   # (col, row)
-        r0, r1 = max(c[1] - radius_cells, 0), min(c[1] + radius_cells + 1, h)
-        c0, c1 = max(c[0] - radius_cells, 0), min(c[0] + radius_cells + 1, wd)
+        row, col = cell_index(point, self.origin, self.resolution)[0]
+        r0, r1 = max(row - radius_cells, 0), min(row + radius_cells + 1, h)
+        c0, c1 = max(col - radius_cells, 0), min(col + radius_cells + 1, wd)
         if r0 >= r1 or c0 >= c1:
             return np.zeros(2)
         patch = self.values[r0:r1, c0:c1]
@@ -197,12 +199,12 @@ class NavigationField:
         the lowest 8-neighbour) until the goal cell or ``max_length``; empty when the
         start is off the patch or cut off from the goal."""
         h, w = self.values.shape
-        p = np.asarray(start, float)[:2]
-        c = np.floor((p - self.origin) / self.resolution).astype(int)[::-1]   # (row, col)
-        if not (0 <= c[0] < h and 0 <= c[1] < w) or not np.isfinite(self.values[c[0], c[1]]):
+        row, col = (int(v) for v in cell_index(np.asarray(start, float)[:2], self.origin,
+                                                self.resolution)[0])
+        if not (0 <= row < h and 0 <= col < w) or not np.isfinite(self.values[row, col]):
             return np.zeros((0, 2))
         downhill = self.downhill
-        cells = [int(c[0]) * w + int(c[1])]
+        cells = [row * w + col]
         for _ in range(int(max_length / self.resolution)):
             nxt = int(downhill[cells[-1]])
             if nxt < 0:
@@ -241,7 +243,7 @@ def crop_box(occupied: NDArray[np.bool_], cells: NDArray[np.int64],
 
 
 def compute_field(occupied: NDArray[np.bool_], origin: ArrayLike, resolution: float,
-                  goal: ArrayLike, robot: ArrayLike, robot_radius: float,
+                  goal: ArrayLike, robot: ArrayLike, inflation_radius: float,
                   clearance_band: float, coarsening: int = 1) -> NavigationField | None:
     """The navigation field to ``goal`` on an occupancy grid (see the module docstring).
 
@@ -252,7 +254,9 @@ def compute_field(occupied: NDArray[np.bool_], origin: ArrayLike, resolution: fl
     the map's cells; if the blocks cut the robot off from a goal those cells reach
     (a gap narrower than a block or two), the field is marched on the cells instead.
     ``goal`` outside the grid is replaced by the nearest cell of the grid's border.
-    Returns None when the goal cell is within ``robot_radius`` of an occupied cell.
+    ``inflation_radius`` [m]: the hard inflation (the robot's footprint; see the module
+    docstring) and ``clearance_band`` [m] the band beyond it where travel speeds up.
+    Returns None when the goal cell is within ``inflation_radius`` of an occupied cell.
     """
     origin = np.asarray(origin, float)
     h, w = occupied.shape
@@ -260,24 +264,24 @@ def compute_field(occupied: NDArray[np.bool_], origin: ArrayLike, resolution: fl
     k = max(int(coarsening), 1)
 
     def cell(p: ArrayLike) -> NDArray[np.int64]:
-        c = np.floor((np.asarray(p, float)[:2] - origin) / resolution).astype(int)[::-1]
-        return np.clip(c, 0, [h - 1, w - 1])
+        return np.clip(cell_index(np.asarray(p, float)[:2], origin, resolution)[0], 0,
+                       [h - 1, w - 1])
 
     gc, rc = cell(g), cell(robot)
-    margin = int(math.ceil((CROP_MARGIN + robot_radius + clearance_band) / resolution))
+    margin = int(math.ceil((CROP_MARGIN + inflation_radius + clearance_band) / resolution))
     r0, r1, c0, c1 = crop_box(occupied, np.array([gc, rc]), margin)
     occ = occupied[r0:r1, c0:c1]
     if k > 1:   # whole blocks: pad with unknown (free) cells beyond the grid
         occ = np.pad(occ, ((0, -occ.shape[0] % k), (0, -occ.shape[1] % k)))
     clear = ndimage.distance_transform_edt(~occ) * resolution if occ.any() \
         else np.full(occ.shape, np.inf)
-    free = clear >= robot_radius
+    free = clear >= inflation_radius
     g_local = (gc[0] - r0, gc[1] - c0)
     if not free[g_local]:
         return None
     labels, _ = ndimage.label(free, structure=np.ones((3, 3)))
     passable = labels == labels[g_local]
-    speed = np.clip((clear - robot_radius) / max(clearance_band, 1e-9), MIN_SPEED, 1.0)
+    speed = np.clip((clear - inflation_radius) / max(clearance_band, 1e-9), MIN_SPEED, 1.0)
     if k > 1:
         blocks = (occ.shape[0] // k, k, occ.shape[1] // k, k)
         occ = occ.reshape(blocks).any(axis=(1, 3))
@@ -292,7 +296,7 @@ def compute_field(occupied: NDArray[np.bool_], origin: ArrayLike, resolution: fl
     field = NavigationField(patch_origin, k * resolution, values, goal_used, passable,
                             resolution)
     if k > 1 and field.reachable(robot) and not np.isfinite(field.value(robot)[0]):
-        return compute_field(occupied, origin, resolution, goal, robot, robot_radius,
+        return compute_field(occupied, origin, resolution, goal, robot, inflation_radius,
                              clearance_band, 1)
     return field
 

@@ -30,7 +30,7 @@ import math
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from .scan import beam_angles, valid_beams
+from .scan import Scan
 
 #: Log-odds increments and clamps (a hit outweighs two misses).
 HIT = 0.9
@@ -39,6 +39,15 @@ LOG_ODDS_MIN = -2.0
 LOG_ODDS_MAX = 3.5
 #: Distance kept between the robot and the window's edge before it recentres [m].
 EDGE_MARGIN = 3.0
+
+
+def cell_index(points: ArrayLike, origin: ArrayLike, resolution: float) -> NDArray[np.int64]:
+    """(row, col) of the cell of each point (n, 2) [m] on a grid whose cell (0, 0) has its
+    corner at ``origin`` (x, y) [m] and whose rows are y: the one world-to-cell rule of
+    the occupancy grid and the navigation field. Cells may lie outside any grid."""
+    p = np.atleast_2d(np.asarray(points, float))
+    return np.floor((p[:, ::-1] - np.asarray(origin, float)[::-1])
+                    / resolution).astype(np.int64)
 
 
 class OccupancyGrid:
@@ -71,8 +80,7 @@ class OccupancyGrid:
 
     def cell_of(self, points: ArrayLike) -> NDArray[np.int64]:
         """(row, col) of each point (n, 2) [m]; may lie outside the window."""
-        p = np.atleast_2d(np.asarray(points, float))
-        return np.floor((p[:, ::-1] - self.origin[::-1]) / self.resolution).astype(np.int64)
+        return cell_index(points, self.origin, self.resolution)
 
     def centre_of(self, cells: ArrayLike) -> NDArray[np.float64]:
         """Odom position of cell centres (n, 2) from (row, col)."""
@@ -124,19 +132,17 @@ class OccupancyGrid:
         self.version += 1
 
     # --- scans ------------------------------------------------------------------------
-    def update(self, ranges: ArrayLike, angle_min: float, angle_increment: float,
-               range_min: float, range_max: float, laser_pose: ArrayLike,
-               clear_range: float = math.inf) -> None:
+    def update(self, scan: Scan, laser_pose: ArrayLike, clear_range: float = math.inf) -> None:
         """Integrate one scan taken with the laser at ``laser_pose`` (x, y, yaw) in odom
-        (see the module docstring for the rule). Geometry is assumed checked
-        (core/scan.scan_to_points refuses bad scans before this is called)."""
-        r = np.asarray(ranges, float).ravel()
+        (see the module docstring for the rule). Its geometry is assumed checked
+        (Scan.check: the planner refuses a bad scan before this is called)."""
+        r = np.asarray(scan.ranges, float).ravel()
         lx, ly, lyaw = (float(v) for v in laser_pose)
-        angles = beam_angles(r.size, angle_min, angle_increment) + lyaw
-        hit = valid_beams(r, range_min, range_max)
-        reach = min(range_max, clear_range)
+        angles = scan.angles + lyaw
+        hit = scan.valid()
+        reach = min(scan.range_max, clear_range)
         with np.errstate(invalid='ignore'):
-            open_beam = np.isposinf(r) & (reach > range_min)
+            open_beam = np.isposinf(r) & (reach > scan.range_min)
         lengths = np.where(hit, r, np.where(open_beam, reach, 0.0))
         use = hit | open_beam
         if not np.any(use):
@@ -152,8 +158,7 @@ class OccupancyGrid:
         # cells in a box around the laser that holds every beam (not the whole window)
         n = self.cells
         reach_cells = int(math.ceil(float(length.max()) / res)) + 1
-        lc = math.floor((lx - self.origin[0]) / res)
-        lr = math.floor((ly - self.origin[1]) / res)
+        lr, lc = (int(v) for v in self.cell_of((lx, ly))[0])
         c0, r0 = min(max(lc - reach_cells, 0), n), min(max(lr - reach_cells, 0), n)
         c1, r1 = min(max(lc + reach_cells + 1, 0), n), min(max(lr + reach_cells + 1, 0), n)
         if c0 >= c1 or r0 >= r1:

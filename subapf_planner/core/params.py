@@ -81,7 +81,3 @@ def build(cls: type[T], values: Mapping[str, Any], *, ignore_unknown: bool = Fal
             kwargs[name] = v
     return cls(**kwargs)
 
-
-def replace(obj: T, **changes: Any) -> T:
-    """A validated copy with some fields changed."""
-    return build(type(obj), {**dataclasses.asdict(obj), **changes})

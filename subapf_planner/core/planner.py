@@ -1,24 +1,29 @@
-"""The planner entry point: (pose, obstacles or scan, goal) -> command + diagnostics.
+"""The planning step: perceive, gate, plan: (pose, scan, goal) -> command + diagnostics.
 
-One planning cycle of ``subharmonic_sampling`` (the paper's full method):
+One cycle of :meth:`Planner.step` (the decision loop, core/loop.py, calls it once
+per period):
 
-1. laser returns -> point obstacles in odom (scan.py), voxel-downsampled for
-   the repulsion sum;
-2. raw next move point from the APF step, eq. (23) (apf.py);
-3. circular sampling, Algorithm 1 and the Fig. 5 priority (sampling.py);
-4. the chosen point -> (v, w) for the differential drive (command.py).
+1. **perceive**: the scan's valid returns -> point obstacles in odom (scan.py,
+   with the laser mounting of robot.py); with ``attraction_field: geodesic``
+   (the default) the scan also goes into the occupancy memory (memory.py);
+2. **gate**: the inputs (:func:`input_status`: non-finite pose or goal; a scan
+   with a bad geometry) and the goal (:func:`goal_status`: reached, inside an
+   obstacle; with the memory, unreachable through it) each stop the robot with
+   their status;
+3. **plan** (:func:`local_plan`, pure): the raw next move point of the APF step,
+   eq. (23) (apf.py), circular sampling, Algorithm 1 and the Fig. 5 priority
+   (sampling.py), the chosen point -> (v, w) (command.py). With the memory the
+   attraction of eq. (21) is replaced by the navigation field (navigation.py).
 
-With ``attraction_field: geodesic`` (the default) the scan also goes into the
-occupancy memory, and the attraction of steps 2-3 is the navigation field
-(memory.py, navigation.py) instead of the Euclidean eq. (21); a goal the field
-cannot reach stops the robot with ``goal_unreachable``.
-
-``subharmonic``, ``traditional`` and ``harmonic`` skip step 3 and steer to the
-raw point (the paper's ablations); ``dwa`` replaces steps 2-4 (dwa.py).
+``subharmonic``, ``traditional`` and ``harmonic`` skip the sampling and steer
+to the raw point (the paper's ablations); ``dwa`` replaces the APF step, the
+sampling and the command shaping (dwa.py). :func:`plan` is steps 2-3 from
+obstacle points, for callers without a scan.
 """
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass, field
 import math
 
@@ -32,7 +37,7 @@ from .dwa import dwa_command
 from .memory import NavigationMemory
 from .navigation import NavigationField
 from .sampling import SamplingResult, clearance, sample_and_choose
-from .scan import ScanError, scan_to_points, voxel_downsample
+from .scan import Scan, ScanError, scan_to_points, voxel_downsample
 from .status import Status
 
 _EMPTY = np.zeros((0, 2))
@@ -50,11 +55,30 @@ class PlanResult:
     nearest_distance: float = math.inf
     goal_distance: float = math.nan
     field: NavigationField | None = None
+    #: Whether this cycle computed a new navigation field (the expensive part).
+    new_field: bool = False
 
 
-def _finite_points(obstacles: ArrayLike) -> NDArray[np.float64]:
-    obs = np.asarray(obstacles, float).reshape(-1, 2)
-    return obs[np.all(np.isfinite(obs), axis=1)]
+def input_status(pose: ArrayLike, goal: ArrayLike) -> Status | None:
+    """Gate on the inputs: ``invalid_pose`` for a pose that is not three finite numbers
+    (x, y, yaw), ``invalid_goal`` for a goal that is not two; None when both are fine."""
+    if np.shape(pose) != (3,) or not np.all(np.isfinite(pose)):
+        return Status.INVALID_POSE
+    if np.shape(goal) != (2,) or not np.all(np.isfinite(goal)):
+        return Status.INVALID_GOAL
+    return None
+
+
+def goal_status(cfg: PlannerConfig, goal_distance: float, goal: NDArray[np.float64],
+                obstacles: NDArray[np.float64]) -> Status | None:
+    """Gate on the goal, ``goal_distance`` [m] from the robot: ``reached`` within
+    goal_tolerance; ``goal_in_obstacle`` when a laser point lies within robot_radius of
+    it (the robot could not stand there); None otherwise."""
+    if goal_distance <= cfg.goal_tolerance:
+        return Status.REACHED
+    if float(clearance(goal, obstacles)[0]) < cfg.robot_radius:
+        return Status.GOAL_IN_OBSTACLE
+    return None
 
 
 def local_radius(cfg: PlannerConfig) -> float:
@@ -68,30 +92,46 @@ def local_radius(cfg: PlannerConfig) -> float:
             + cfg.max_step + 2.0 * cfg.sample_radius)
 
 
+def _situation(pose: NDArray, goal: NDArray, obstacles: ArrayLike) -> dict:
+    """Finite obstacle points (m, 2) and the robot's distances to them and to the goal,
+    the diagnostics every PlanResult of a cycle carries."""
+    obs = np.asarray(obstacles, float).reshape(-1, 2)
+    obs = obs[np.all(np.isfinite(obs), axis=1)]
+    position = pose[:2]
+    return dict(obstacles=obs, nearest_distance=float(clearance(position, obs)[0]),
+                goal_distance=float(np.hypot(*(goal - position))))
+
+
 def plan(cfg: PlannerConfig, pose: ArrayLike, goal: ArrayLike, obstacles: ArrayLike,
          previous: tuple[float, float] = (0.0, 0.0),
          field: NavigationField | None = None) -> PlanResult:
-    """One planning cycle. pose (x, y, yaw), goal (x, y), obstacles (m, 2), all in odom.
-    ``field``: the navigation-function attraction (None: Euclidean, eq. 21).
+    """Gate and plan one cycle from obstacle points: pose (x, y, yaw), goal (x, y),
+    obstacles (m, 2), all in odom; ``previous`` the last command (v, w); ``field`` the
+    navigation-function attraction (None: Euclidean, eq. 21).
 
     Never raises for bad numbers: a non-finite pose or goal gives a stop with
     status ``invalid_pose`` / ``invalid_goal``; non-finite obstacle points are dropped.
     """
     pose = np.asarray(pose, float).ravel()
     goal = np.asarray(goal, float).ravel()
-    if pose.shape != (3,) or not np.all(np.isfinite(pose)):
-        return PlanResult(Command(0.0, 0.0, Status.INVALID_POSE))
-    if goal.shape != (2,) or not np.all(np.isfinite(goal)):
-        return PlanResult(Command(0.0, 0.0, Status.INVALID_GOAL))
-    obs = _finite_points(obstacles)
-    position = pose[:2]
-    nearest = float(clearance(position, obs)[0])
-    goal_distance = float(np.hypot(*(goal - position)))
-    common = dict(obstacles=obs, nearest_distance=nearest, goal_distance=goal_distance)
-    if goal_distance > cfg.goal_tolerance and float(clearance(goal, obs)[0]) < cfg.robot_radius:
-        return PlanResult(Command(0.0, 0.0, Status.GOAL_IN_OBSTACLE), **common)
+    status = input_status(pose, goal)
+    if status is not None:
+        return PlanResult(Command(0.0, 0.0, status))
+    seen = _situation(pose, goal, obstacles)
+    status = goal_status(cfg, seen['goal_distance'], goal, seen['obstacles'])
+    if status is not None:
+        return PlanResult(Command(0.0, 0.0, status), field=field, **seen)
+    return local_plan(cfg, pose, goal, seen, previous, field)
+
+
+def local_plan(cfg: PlannerConfig, pose: NDArray, goal: NDArray, seen: dict,
+               previous: tuple[float, float], field: NavigationField | None) -> PlanResult:
+    """Step 3 of the module docstring for inputs that passed the gates; ``seen`` as
+    :func:`_situation` gives it."""
+    obs = seen['obstacles']
     if cfg.method == 'dwa':
-        return _plan_dwa(cfg, pose, goal, obs, previous, common, field)
+        return _plan_dwa(cfg, pose, goal, previous, seen, field)
+    position = pose[:2]
     offset = obs - position
     near = obs[offset[:, 0] ** 2 + offset[:, 1] ** 2 <= local_radius(cfg) ** 2]
     repulsors = voxel_downsample(near, cfg.voxel_size)
@@ -102,27 +142,26 @@ def plan(cfg: PlannerConfig, pose: ArrayLike, goal: ArrayLike, obstacles: ArrayL
         sampling = sample_and_choose(raw, position, goal, near, repulsors, cfg, field)
         target = sampling.chosen
     cmd = shape_command(pose, target, goal, previous, near, cfg)
-    return PlanResult(cmd, raw, target, sampling, field=field, **common)
+    return PlanResult(cmd, raw, target, sampling, field=field, **seen)
 
 
-def _plan_dwa(cfg: PlannerConfig, pose: NDArray, goal: NDArray, obs: NDArray,
-              previous: tuple[float, float], common: dict,
+def _plan_dwa(cfg: PlannerConfig, pose: NDArray, goal: NDArray,
+              previous: tuple[float, float], seen: dict,
               field: NavigationField | None) -> PlanResult:
-    if common['goal_distance'] <= cfg.goal_tolerance:
-        return PlanResult(Command(0.0, 0.0, Status.REACHED), **common)
+    obs = seen['obstacles']
     res = dwa_command(pose, goal, previous, voxel_downsample(obs, cfg.voxel_size), cfg, field)
     if not res.admissible:
-        return PlanResult(Command(0.0, 0.0, Status.NO_SAFE_MOVE), **common)
+        return PlanResult(Command(0.0, 0.0, Status.NO_SAFE_MOVE), field=field, **seen)
     v, status = res.v, Status.DRIVING if res.v > 0.0 else Status.TURNING
     if v > 0.0 and forward_blocked(pose, obs, cfg):
         v, status = 0.0, Status.BLOCKED_AHEAD
     return PlanResult(Command(v, res.w, status), None, res.trajectory[-1].copy(), field=field,
-                      **common)
+                      **seen)
 
 
 class Planner:
-    """Stateful wrapper: the last command (acceleration limits) and, with the geodesic
-    attraction, the occupancy memory and its navigation field."""
+    """The planning step with its state: the last command (acceleration limits) and, with
+    the geodesic attraction, the occupancy memory and its navigation field."""
 
     def __init__(self, cfg: PlannerConfig) -> None:
         self._cfg = cfg
@@ -147,45 +186,43 @@ class Planner:
         self.reset()
         self.memory.forget()
 
-    def step(self, pose: ArrayLike, goal: ArrayLike, obstacles: ArrayLike,
-             field: NavigationField | None = None) -> PlanResult:
-        """Plan from obstacle points in odom (Euclidean attraction unless ``field``)."""
-        result = plan(self.cfg, pose, goal, obstacles, self.previous, field)
-        self.previous = (result.command.v, result.command.w)
-        return result
+    def step(self, pose: ArrayLike, goal: ArrayLike, scan: Scan,
+             scan_pose: ArrayLike | None = None, now: float | None = None) -> PlanResult:
+        """Perceive, gate and plan one cycle (module docstring) for the robot at ``pose``
+        (x, y, yaw) in odom driving to ``goal`` (x, y).
 
-    def step_scan(self, pose: ArrayLike, goal: ArrayLike, ranges: ArrayLike, angle_min: float,
-                  angle_increment: float, range_min: float, range_max: float,
-                  scan_pose: ArrayLike | None = None, stamp: float | None = None,
-                  now: float | None = None) -> PlanResult:
-        """Plan from a laser scan; see scan.scan_to_points.
-
-        ``scan_pose`` is the robot's odom pose when the scan was taken (default:
-        ``pose``); a robot that moved since is planned for from ``pose``. With the
-        geodesic attraction the scan (identified by ``stamp`` [s]; None: always new)
-        goes into the memory and the field is updated (``now`` [s] rate-limits it).
+        ``scan_pose``: base_footprint's odom pose when the scan was taken (default
+        ``pose``); a robot that moved since is planned for from ``pose``. ``now`` [s]
+        rate-limits the navigation field (None: recomputed whenever the map changed).
         """
         cfg = self.cfg
+        pose = np.asarray(pose, float).ravel()
+        goal = np.asarray(goal, float).ravel()
+        status = input_status(pose, goal)
+        if status is not None:
+            return self._stop(PlanResult(Command(0.0, 0.0, status)))
         scan_pose = pose if scan_pose is None else scan_pose
-        if not np.all(np.isfinite(np.asarray(pose, float))) \
-                or not np.all(np.isfinite(np.asarray(goal, float))):
-            return self.step(pose, goal, _EMPTY)
-        try:
-            pts = scan_to_points(ranges, angle_min, angle_increment, range_min, range_max,
-                                 scan_pose, (cfg.laser_x, cfg.laser_y, cfg.laser_yaw),
-                                 cfg.obstacle_range)
+        try:   # perceive
+            points = scan_to_points(scan, scan_pose, cfg.laser_mount, cfg.obstacle_range)
         except ScanError:
-            self.reset()
-            return PlanResult(Command(0.0, 0.0, Status.INVALID_SCAN))
-        if not cfg.geodesic or float(clearance(goal, pts)[0]) < cfg.robot_radius:
-            return self.step(pose, goal, pts)   # (plan() stops for a goal in an obstacle)
-        self.memory.integrate(ranges, angle_min, angle_increment, range_min, range_max,
-                              scan_pose, math.nan if stamp is None else stamp, goal)
-        field = self.memory.field_for(np.asarray(pose, float)[:2], goal, now)
-        position = np.asarray(pose, float)[:2]
-        if float(np.hypot(*(np.asarray(goal, float) - position))) > cfg.goal_tolerance and (
-                field is None or not field.reachable(position)):
-            self.reset()
-            return PlanResult(Command(0.0, 0.0, Status.GOAL_UNREACHABLE), obstacles=pts,
-                              field=field)
-        return self.step(pose, goal, pts, field)
+            return self._stop(PlanResult(Command(0.0, 0.0, Status.INVALID_SCAN)))
+        if cfg.geodesic:
+            self.memory.integrate(scan, scan_pose, goal)
+        seen = _situation(pose, goal, points)
+        status = goal_status(cfg, seen['goal_distance'], goal, seen['obstacles'])
+        field, new_field = None, False
+        if status is None and cfg.geodesic:   # the goal through the memory
+            field = self.memory.field_for(pose[:2], goal, now)
+            new_field = self.memory.recomputed
+            if field is None or not field.reachable(pose[:2]):
+                status = Status.GOAL_UNREACHABLE
+        if status is not None:
+            return self._stop(PlanResult(Command(0.0, 0.0, status), field=field,
+                                         new_field=new_field, **seen))
+        result = local_plan(cfg, pose, goal, seen, self.previous, field)
+        self.previous = (result.command.v, result.command.w)
+        return dataclasses.replace(result, new_field=new_field) if new_field else result
+
+    def _stop(self, result: PlanResult) -> PlanResult:
+        self.reset()
+        return result

@@ -33,7 +33,7 @@ LN10 = math.log(10.0)
 MIN_DISTANCE = 1e-6
 
 
-def _r(r: ArrayLike) -> NDArray[np.float64]:
+def _floored(r: ArrayLike) -> NDArray[np.float64]:
     return np.maximum(np.asarray(r, dtype=float), MIN_DISTANCE)
 
 
@@ -45,7 +45,7 @@ def _check_kind(kind: str) -> None:
 def repulsive_value(kind: str, r: ArrayLike, gain: float, k: float) -> NDArray[np.float64]:
     """phi(r) of one obstacle point at distance r [m]."""
     _check_kind(kind)
-    r = _r(r)
+    r = _floored(r)
     if kind == 'traditional':
         return gain / r
     if kind == 'harmonic':
@@ -56,7 +56,7 @@ def repulsive_value(kind: str, r: ArrayLike, gain: float, k: float) -> NDArray[n
 def repulsive_dr(kind: str, r: ArrayLike, gain: float, k: float) -> NDArray[np.float64]:
     """d phi / d r (negative: the potential falls away from the obstacle)."""
     _check_kind(kind)
-    r = _r(r)
+    r = _floored(r)
     if kind == 'traditional':
         return -gain / (r * r)
     if kind == 'harmonic':
@@ -67,7 +67,7 @@ def repulsive_dr(kind: str, r: ArrayLike, gain: float, k: float) -> NDArray[np.f
 def repulsive_laplacian(kind: str, r: ArrayLike, gain: float, k: float) -> NDArray[np.float64]:
     """2-D Laplacian phi'' + phi'/r of a radial potential (eq. 4)."""
     _check_kind(kind)
-    r = _r(r)
+    r = _floored(r)
     if kind == 'traditional':
         return gain / r ** 3
     if kind == 'harmonic':

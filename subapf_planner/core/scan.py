@@ -7,14 +7,54 @@ values below ``range_min`` and values at or beyond ``range_max`` (no return).
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 import math
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from .robot import to_parent
+
 
 class ScanError(ValueError):
     """The scan's geometry is unusable (e.g. angle_increment not positive)."""
+
+
+@dataclass(frozen=True, eq=False)
+class Scan:
+    """One 2-D laser sweep in the laser's frame (``base_scan``), as every layer passes it:
+    the simulator makes it, the node's conversion builds it from a LaserScan, the decision
+    loop holds it and the planner, the memory and the occupancy grid take it whole.
+
+    ranges [m] (any value; see :func:`valid_beams`), beam i at ``angle_min + i *
+    angle_increment`` [rad], valid returns in [range_min, range_max) [m], ``stamp``:
+    capture time [s] (NaN: unknown, every use of it is new).
+    """
+
+    ranges: NDArray[np.float64]
+    angle_min: float
+    angle_increment: float
+    range_min: float
+    range_max: float
+    stamp: float = math.nan
+
+    def check(self) -> None:
+        """Raise ScanError for a non-finite geometry or an angle_increment <= 0 with more
+        than one beam (an empty scan is fine: open space)."""
+        geometry = (self.angle_min, self.angle_increment, self.range_min, self.range_max)
+        if not all(math.isfinite(v) for v in geometry):
+            raise ScanError(f'non-finite scan geometry {geometry}')
+        if np.size(self.ranges) > 1 and self.angle_increment <= 0.0:
+            raise ScanError(f'angle_increment must be positive, got {self.angle_increment}')
+
+    @property
+    def angles(self) -> NDArray[np.float64]:
+        """Angle of each beam in the laser frame [rad]."""
+        return beam_angles(np.size(self.ranges), self.angle_min, self.angle_increment)
+
+    def valid(self, max_range: float = math.inf) -> NDArray[np.bool_]:
+        """Mask of usable returns (:func:`valid_beams`), no farther than ``max_range``."""
+        return valid_beams(self.ranges, self.range_min, self.range_max, max_range)
 
 
 def beam_angles(n: int, angle_min: float, angle_increment: float) -> NDArray[np.float64]:
@@ -31,35 +71,25 @@ def valid_beams(ranges: ArrayLike, range_min: float, range_max: float,
                 & (r <= max_range))
 
 
-def scan_to_points(ranges: ArrayLike, angle_min: float, angle_increment: float,
-                   range_min: float, range_max: float, pose: ArrayLike,
-                   laser_offset: ArrayLike = (0.0, 0.0, 0.0),
+def scan_to_points(scan: Scan, pose: ArrayLike, mount: ArrayLike = (0.0, 0.0, 0.0),
                    max_range: float = math.inf) -> NDArray[np.float64]:
-    """Valid laser returns as (m, 2) points in the frame the robot ``pose`` is given in.
+    """The scan's valid returns as (m, 2) points in the frame ``pose`` is given in [m].
 
-    pose: (x, y, yaw) of base_footprint in odom [m, m, rad];
-    laser_offset: (x, y, yaw) of the laser in base_footprint.
-    Raises ScanError for a non-finite geometry or an angle_increment <= 0 with
-    more than one beam; an empty scan gives an empty (0, 2) array.
+    pose: (x, y, yaw) of base_footprint in odom [m, m, rad] when the scan was taken;
+    mount: (x, y, yaw) of the laser in base_footprint (RobotDescription.laser.planar).
+    Raises ScanError for a bad geometry (Scan.check) or a non-finite pose or mounting;
+    an empty scan gives an empty (0, 2) array.
     """
-    r = np.asarray(ranges, dtype=float).ravel()
-    geometry = (angle_min, angle_increment, range_min, range_max)
-    if not all(math.isfinite(v) for v in geometry):
-        raise ScanError(f'non-finite scan geometry {geometry}')
-    if r.size > 1 and angle_increment <= 0.0:
-        raise ScanError(f'angle_increment must be positive, got {angle_increment}')
-    x, y, yaw = (float(v) for v in pose)
-    lx, ly, lyaw = (float(v) for v in laser_offset)
-    if not all(math.isfinite(v) for v in (x, y, yaw, lx, ly, lyaw)):
+    scan.check()
+    if not all(math.isfinite(float(v)) for v in (*pose, *mount)):
         raise ScanError('non-finite robot pose or laser offset')
-    mask = valid_beams(r, range_min, range_max, max_range)
+    r = np.asarray(scan.ranges, dtype=float).ravel()
+    mask = scan.valid(max_range)
     rv = r[mask]
-    a = beam_angles(r.size, angle_min, angle_increment)[mask] + lyaw
+    a = scan.angles[mask]
     # laser frame -> base frame -> odom frame
-    bx = lx + rv * np.cos(a)
-    by = ly + rv * np.sin(a)
-    c, s = math.cos(yaw), math.sin(yaw)
-    return np.column_stack((x + c * bx - s * by, y + s * bx + c * by))
+    in_laser = np.column_stack((rv * np.cos(a), rv * np.sin(a)))
+    return to_parent(pose, to_parent(mount, in_laser))
 
 
 def geometry_warning(n: int, angle_min: float, angle_max: float,

@@ -35,7 +35,7 @@ STOP_STATUSES = frozenset({Status.NO_SAFE_MOVE, Status.GOAL_IN_OBSTACLE,
 
 
 class State(StrEnum):
-    """The planner node's state (core/controller.py), the text before the colon."""
+    """The planner node's state (core/loop.py), the text before the colon."""
 
     IDLE = 'idle'
     WAITING = 'waiting'

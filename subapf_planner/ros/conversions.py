@@ -12,40 +12,48 @@ from nav_msgs.msg import Odometry, Path
 import numpy as np
 from sensor_msgs.msg import LaserScan
 
-from ..core.controller import ScanInput
+from ..bag.events import stamp_ns
 from ..core.occupancy import OccupancyGrid
+from ..core.scan import Scan
 
 
 def stamp_to_seconds(stamp: Time) -> float:
-    return stamp.sec + stamp.nanosec * 1e-9
+    """A header stamp as seconds, as rclpy's clock gives them (integer ns * 1e-9): the one
+    stamp conversion of the package (bag/events.stamp_ns is the exact integer)."""
+    return stamp_ns(stamp) * 1e-9
 
 
-def seconds_to_stamp(t: float) -> Time:
-    ns = int(round(t * 1e9))
+def ns_to_stamp(ns: int) -> Time:
+    """Integer nanoseconds as a header stamp (exact)."""
     return Time(sec=ns // 1_000_000_000, nanosec=ns % 1_000_000_000)
 
 
-def scan_from_msg(msg: LaserScan) -> ScanInput:
-    """LaserScan -> ScanInput. Geometry is checked later by scan.scan_to_points."""
-    return ScanInput(np.asarray(msg.ranges, dtype=float), float(msg.angle_min),
-                     float(msg.angle_increment), float(msg.range_min), float(msg.range_max),
-                     stamp_to_seconds(msg.header.stamp))
+def seconds_to_stamp(t: float) -> Time:
+    return ns_to_stamp(int(round(t * 1e9)))
 
 
-def scan_to_msg(ranges: np.ndarray, angle_min: float, angle_increment: float,
-                range_min: float, range_max: float, stamp: float, frame_id: str,
-                scan_time: float = 0.2) -> LaserScan:
+def scan_from_msg(msg: LaserScan) -> Scan:
+    """LaserScan -> Scan (stamp [s]). Its geometry is checked by the planner (Scan.check)."""
+    return Scan(np.asarray(msg.ranges, dtype=float), float(msg.angle_min),
+                float(msg.angle_increment), float(msg.range_min), float(msg.range_max),
+                stamp_to_seconds(msg.header.stamp))
+
+
+def scan_to_msg(scan: Scan, frame_id: str, scan_time: float = 0.2) -> LaserScan:
+    """Scan -> LaserScan in ``frame_id``, stamped with the scan's stamp; ``scan_time``
+    [s] is the sweep's duration (5 Hz: 0.2)."""
+    n = len(scan.ranges)
     msg = LaserScan()
-    msg.header.stamp = seconds_to_stamp(stamp)
+    msg.header.stamp = seconds_to_stamp(scan.stamp)
     msg.header.frame_id = frame_id
-    msg.angle_min = float(angle_min)
-    msg.angle_increment = float(angle_increment)
-    msg.angle_max = float(angle_min + angle_increment * (len(ranges) - 1))
-    msg.range_min = float(range_min)
-    msg.range_max = float(range_max)
+    msg.angle_min = float(scan.angle_min)
+    msg.angle_increment = float(scan.angle_increment)
+    msg.angle_max = float(scan.angle_min + scan.angle_increment * (n - 1))
+    msg.range_min = float(scan.range_min)
+    msg.range_max = float(scan.range_max)
     msg.scan_time = float(scan_time)
-    msg.time_increment = float(scan_time / max(len(ranges), 1))
-    msg.ranges = np.asarray(ranges, dtype=np.float32).tolist()
+    msg.time_increment = float(scan_time / max(n, 1))
+    msg.ranges = np.asarray(scan.ranges, dtype=np.float32).tolist()
     return msg
 
 

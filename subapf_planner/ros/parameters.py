@@ -44,10 +44,6 @@ def declare(node: Node, *classes: type) -> None:
             node.declare_parameter(f.name, f.default, descriptor(f))
 
 
-def names(*classes: type) -> set[str]:
-    return {f.name for cls in classes for f in dataclasses.fields(cls)}
-
-
 def read(node: Node, cls: type[T], changes: dict[str, Any] | None = None) -> T:
     """The node's current values of ``cls``'s fields, with ``changes`` on top, validated
     (ConfigError naming the parameter when a value is not admissible)."""

@@ -7,10 +7,11 @@ Topics (relative, so namespaces and remapping work):
        enable_stamped_cmd_vel:=false), ~/status (std_msgs/String,
        "state: reason"), ~/markers (visualization_msgs/MarkerArray),
        ~/map (nav_msgs/OccupancyGrid, transient local, the occupancy memory),
-       ~/plan (nav_msgs/Path, the navigation field's steepest descent)
+       ~/plan (nav_msgs/Path, the navigation field's steepest descent, sent for each
+       new field and as the robot moves)
 
 The node only translates messages and parameters and drives one timer; the
-decisions are subapf_planner.core.controller's.
+decisions are subapf_planner.core.loop's, the input checks ros/intake.py's.
 """
 
 from __future__ import annotations
@@ -28,24 +29,17 @@ from rclpy.duration import Duration
 from rclpy.exceptions import ParameterException
 from rclpy.node import Node
 from rclpy.qos import qos_profile_sensor_data
-from rclpy.time import Time
 from sensor_msgs.msg import LaserScan
 from std_msgs.msg import String
 from visualization_msgs.msg import MarkerArray
 
+from ..bag.events import stamp_ns
 from ..core.config import ConfigError, PlannerConfig
-from ..core.controller import PlannerController, Supervision
+from ..core.loop import DecisionLoop, Supervision
 from ..core.navigation import thin_polyline
 from ..core.params import check_fields, param
-from ..core.scan import geometry_warning
-from .conversions import (
-    cmd_to_msg,
-    grid_to_msg,
-    path_to_msg,
-    pose_from_odom,
-    scan_from_msg,
-    stamp_to_seconds,
-)
+from .conversions import cmd_to_msg, grid_to_msg, path_to_msg
+from .intake import Intake
 from .markers import markers_from_result
 from .parameters import declare, read
 from .qos import LATCHED
@@ -80,7 +74,8 @@ class NodeOptions:
                               '(nav_msgs/OccupancyGrid, transient local) at map_rate')
     map_rate: float = param(1.0, 'Rate of ~/map', 'Hz', 0.1, 5.0)
     publish_plan: bool = param(True, "Publish the field's steepest-descent path from the "
-                               'robot on ~/plan (nav_msgs/Path) every cycle')
+                               'robot on ~/plan (nav_msgs/Path) for each new field, and '
+                               'when the robot moved 0.25 m or a second passed')
     laser_frame: str = param('base_scan', 'Expected scan frame_id; empty accepts any')
     odom_frame: str = param('odom', 'Frame of odometry and goals')
 
@@ -100,8 +95,9 @@ class PlannerNode(Node):
         declare(self, *GROUPS)
         # a bad start value raises ConfigError naming it (exit code 2)
         self.options = read(self, NodeOptions)
-        self.cfg = read(self, PlannerConfig)
-        self.ctl = PlannerController(self.cfg, read(self, Supervision))
+        self.ctl = DecisionLoop(read(self, PlannerConfig), read(self, Supervision))
+        self.intake = Intake(self.options.laser_frame, self.options.odom_frame)
+        self._pending: dict[type, object] = {}   # groups validated by the on-set callback
         self.add_on_set_parameters_callback(self._validate_parameters)
         self.add_post_set_parameters_callback(self._apply_parameters)
 
@@ -122,36 +118,42 @@ class PlannerNode(Node):
         self._last_state = ''
         if self.options.goal_from_parameters:
             self._set_goal(np.array([self.options.goal_x, self.options.goal_y]))
-        self.timer = self.create_timer(self.cfg.period, self._on_timer)
+        cfg = self.ctl.cfg
+        self.timer = self.create_timer(cfg.period, self._on_timer)
         self._jump_handle = self.get_clock().create_jump_callback(
             JumpThreshold(min_forward=Duration(seconds=CLOCK_JUMP),
                           min_backward=Duration(nanoseconds=-1), on_clock_change=False),
             post_callback=self._on_clock_jump)
         self.get_logger().info(
-            f'method={self.cfg.method} d0={self.cfg.danger_distance} m '
-            f'samples={self.cfg.num_samples} R={self.cfg.sample_radius} m '
-            f'rate={self.cfg.planning_frequency} Hz v_max={self.cfg.max_linear_velocity} m/s '
+            f'method={cfg.method} d0={cfg.danger_distance} m '
+            f'samples={cfg.num_samples} R={cfg.sample_radius} m '
+            f'rate={cfg.planning_frequency} Hz v_max={cfg.max_linear_velocity} m/s '
             f'cmd_vel={"TwistStamped" if stamped else "Twist"}')
 
     # --- parameters -------------------------------------------------------------------
     def _validate_parameters(self, params: list) -> SetParametersResult:
-        """Refuse a change that makes any parameter group invalid (old values kept)."""
+        """Refuse a change that makes any parameter group invalid (old values kept); the
+        groups built here are what the post-set callback applies."""
         changes = {p.name: p.value for p in params}
         try:
-            for group in GROUPS:
-                read(self, group, changes)
+            self._pending = {group: read(self, group, changes) for group in GROUPS}
         except ConfigError as exc:
+            self._pending = {}
             return SetParametersResult(successful=False, reason=str(exc))
         return SetParametersResult(successful=True)
 
     def _apply_parameters(self, params: list) -> None:
         """Apply accepted changes: the core's configuration, the limits, the timer."""
-        cfg = read(self, PlannerConfig)
-        if cfg.planning_frequency != self.cfg.planning_frequency:
+        pending, self._pending = self._pending, {}
+        if not pending:
+            return
+        cfg = pending[PlannerConfig]
+        if cfg.planning_frequency != self.ctl.cfg.planning_frequency:
             self.timer.timer_period_ns = int(cfg.period * 1e9)
-        self.options = read(self, NodeOptions)
-        self.cfg = self.ctl.cfg = cfg
-        self.ctl.limits = read(self, Supervision)
+        self.options = pending[NodeOptions]
+        self.intake = Intake(self.options.laser_frame, self.options.odom_frame)
+        self.ctl.cfg = cfg
+        self.ctl.limits = pending[Supervision]
 
     def _on_clock_jump(self, jump) -> None:
         self.get_logger().warn(f'clock jumped by {jump.delta.nanoseconds * 1e-9:+.2f} s '
@@ -162,43 +164,30 @@ class PlannerNode(Node):
     def _now(self) -> float:
         return self.get_clock().now().nanoseconds * 1e-9
 
-    def _on_scan(self, msg: LaserScan) -> None:
-        expected = self.options.laser_frame
-        if expected and msg.header.frame_id != expected:
-            self.get_logger().warn(f'scan in frame "{msg.header.frame_id}", expected '
-                                   f'"{expected}": dropped', throttle_duration_sec=5.0)
-            return
-        problem = geometry_warning(len(msg.ranges), msg.angle_min, msg.angle_max,
-                                   msg.angle_increment)
+    def _warn(self, problem: str | None) -> None:
         if problem:
-            self.get_logger().warn(f'scan header: {problem}', throttle_duration_sec=5.0)
-        self.ctl.update_scan(scan_from_msg(msg), self._now())
+            self.get_logger().warn(problem, throttle_duration_sec=5.0)
+
+    def _on_scan(self, msg: LaserScan) -> None:
+        self._warn(self.intake.scan(self.ctl, msg, self._now()))
 
     def _on_odom(self, msg: Odometry) -> None:
-        pose = pose_from_odom(msg)
-        if not np.all(np.isfinite(pose)):
-            self.get_logger().warn('odometry with a non-finite pose: dropped',
-                                   throttle_duration_sec=5.0)
-            return
-        if not self.ctl.update_odom(stamp_to_seconds(msg.header.stamp), pose, self._now()):
-            self.get_logger().warn('odometry stamp went back in time: pose history cleared',
-                                   throttle_duration_sec=5.0)
+        self._warn(self.intake.odom(self.ctl, msg, self._now()))
 
     def _on_goal(self, msg: PoseStamped) -> None:
-        frame = self.options.odom_frame
-        goal = np.array([msg.pose.position.x, msg.pose.position.y], dtype=float)
-        if msg.header.frame_id not in ('', frame):
-            self.get_logger().error(f'goal in frame "{msg.header.frame_id}" refused: give it '
-                                    f'in "{frame}"')
-            return
-        if not np.all(np.isfinite(goal)):
-            self.get_logger().error('goal with a non-finite position refused')
-            return
-        self._set_goal(goal)
+        new, refused = self.intake.goal(self.ctl, msg)
+        if refused:
+            self.get_logger().error(refused)
+        elif new:
+            self._log_goal()
 
     def _set_goal(self, goal: np.ndarray) -> None:
         if self.ctl.set_goal(goal):
-            self.get_logger().info(f'goal ({goal[0]:.2f}, {goal[1]:.2f})')
+            self._log_goal()
+
+    def _log_goal(self) -> None:
+        goal = self.ctl.goal
+        self.get_logger().info(f'goal ({goal[0]:.2f}, {goal[1]:.2f})')
 
     # --- the planning cycle -----------------------------------------------------------
     def _take_arrived_inputs(self, tick_ns: int) -> list:
@@ -211,7 +200,7 @@ class PlannerNode(Node):
             with sub.handle:
                 while (taken := sub.handle.take_message(sub.msg_type, sub.raw)) is not None:
                     msg = taken[0]
-                    if Time.from_msg(msg.header.stamp).nanoseconds <= tick_ns:
+                    if stamp_ns(msg.header.stamp) <= tick_ns:
                         handler(msg)
                     else:
                         later.append((handler, msg))
@@ -226,9 +215,10 @@ class PlannerNode(Node):
         if decision.command is not None:   # the command first, stamped with the tick time
             self._publish_cmd(*decision.command, stamp=tick.to_msg())
         if decision.result is not None and self.options.publish_markers:
+            cfg = self.ctl.cfg
             self.marker_pub.publish(markers_from_result(
                 decision.result, self.options.odom_frame, tick.to_msg(),
-                self.cfg.danger_distance, self.ctl.pose, self.cfg.voxel_size))
+                cfg.danger_distance, self.ctl.pose, cfg.voxel_size))
         self._publish_memory(decision, tick)
         if decision.state.halted and decision.text != self._last_state:
             self.get_logger().warn(decision.text)
@@ -238,7 +228,7 @@ class PlannerNode(Node):
     def _publish_memory(self, decision, tick) -> None:
         """~/plan for each new field, and when the robot moved PLAN_SPACING or PLAN_PERIOD
         passed (its points PLAN_SPACING apart); ~/map at most at map_rate."""
-        if not self.cfg.geodesic:
+        if not self.ctl.cfg.geodesic:
             return
         frame, now = self.options.odom_frame, tick.nanoseconds * 1e-9
         field = decision.result.field if decision.result is not None else None
@@ -254,8 +244,7 @@ class PlannerNode(Node):
         if self.options.publish_map and (self._map_time is None or now < self._map_time
                                          or now - self._map_time >= 1.0 / self.options.map_rate):
             self._map_time = now
-            self.map_pub.publish(grid_to_msg(self.ctl.planner.memory.grid, frame,
-                                             tick.to_msg()))
+            self.map_pub.publish(grid_to_msg(self.ctl.grid, frame, tick.to_msg()))
 
     def _publish_cmd(self, v: float, w: float, stamp=None) -> None:
         stamped = self.cmd_pub.msg_type is TwistStamped

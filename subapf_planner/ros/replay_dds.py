@@ -9,7 +9,7 @@ at that instant, the player waits for the node's own ``cmd_vel`` for it before
 going on: a TwistStamped carries its tick's stamp, a Twist is taken as the answer
 to the ``/clock`` instant at which it arrives. So the replay runs as fast as the
 node answers, and its commands can be compared one by one with the recorded ones
-and with the in-process replay (tools/replay.py).
+and with the in-process replay (ros/replay.py).
 """
 
 from __future__ import annotations
@@ -18,7 +18,6 @@ from pathlib import Path
 import subprocess
 import time
 
-from builtin_interfaces.msg import Time
 from geometry_msgs.msg import PoseStamped, Twist, TwistStamped
 from nav_msgs.msg import Odometry
 import numpy as np
@@ -32,7 +31,7 @@ from std_msgs.msg import String
 from ..bag.comparison import Comparison
 from ..bag.events import STAMPED_CMD, Event, check_topics, events, stamp_ns
 from ..bag.reader import BagError
-from .conversions import cmd_from_msg
+from .conversions import cmd_from_msg, ns_to_stamp
 from .processes import join_domain, start, stop
 
 #: Longest wait for the node's answer to one tick [s].
@@ -45,10 +44,6 @@ FIRST_CLOCK_LEAD = 50_000_000
 #: reach the node before the clock makes it tick: DDS does not order messages across
 #: topics, and the scan is best effort (never acknowledged) [s].
 INPUT_SETTLE = 0.01
-
-
-def _time(ns: int) -> Time:
-    return Time(sec=ns // 1_000_000_000, nanosec=ns % 1_000_000_000)
 
 
 def _instants(stream: list[Event]) -> list[tuple[int, list[Event], list[Event]]]:
@@ -128,7 +123,7 @@ def _play(node: Node, context, child: subprocess.Popen, instants: list,
 
     def publish_clock(ns: int) -> None:
         clock_now[0] = ns
-        clock.publish(Clock(clock=_time(ns)))
+        clock.publish(Clock(clock=ns_to_stamp(ns)))
 
     deadline = time.monotonic() + 30.0
     while not all(p.get_subscription_count() > 0 for p in (*pubs.values(), clock)) or \

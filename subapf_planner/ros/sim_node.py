@@ -13,7 +13,7 @@ tf2_msgs is installed (not among the PyPI ROS wheels; odom carries the same pose
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 import sys
 
 from geometry_msgs.msg import Twist, TwistStamped
@@ -28,7 +28,7 @@ from ..core.params import ConfigError, check_fields, param
 from ..core.status import Outcome
 from ..sim.faults import FAULT_SEED_OFFSET, ScanDelivery, ScanFaults
 from ..sim.outcome import outcome_of
-from ..sim.simulator import LASER_OFFSET, BurgerSim, SimConfig
+from ..sim.simulator import ROBOT, BurgerSim, SimConfig
 from ..sim.world import WorldError, load_world
 from .conversions import (
     cmd_from_msg,
@@ -45,8 +45,8 @@ from .spinning import spin_node
 TICK = 0.05
 SCAN_PERIOD = 0.2
 #: REP-105 frames of the burger: base_link above base_footprint, base_scan in base_link.
-BASE_LINK_HEIGHT = 0.010
-LASER_IN_BASE_LINK = (LASER_OFFSET[0], LASER_OFFSET[1], LASER_OFFSET[2] - BASE_LINK_HEIGHT)
+BASE_LINK_HEIGHT = ROBOT.base_link_height
+LASER_IN_BASE_LINK = (ROBOT.laser.x, ROBOT.laser.y, ROBOT.laser.z - BASE_LINK_HEIGHT)
 #: Shortest wall-clock period of the stepping timer [s].
 MIN_TIMER_PERIOD = 0.005
 
@@ -137,9 +137,7 @@ class SimNode(Node):
         self.truth_pub.publish(odom_to_msg(sim.true_pose(), twist, t, 'world'))
         if t + 1e-9 >= self._next_scan:
             self._next_scan += SCAN_PERIOD
-            s = sim.scan()
-            self._scans.capture(scan_to_msg(s.ranges, s.angle_min, s.angle_increment,
-                                            s.range_min, s.range_max, t, 'base_scan'), t)
+            self._scans.capture(scan_to_msg(replace(sim.scan(), stamp=t), 'base_scan'), t)
         # scans go out scan_latency after capture, stamped with their capture time
         for msg in self._scans.due(t):
             self.scan_pub.publish(msg)

@@ -1,6 +1,6 @@
 """One benchmark run: the simulator and the node's decision loop, in one process.
 
-At each planning period the ``PlannerController`` (the loop ``planner_node``
+At each planning period the ``DecisionLoop`` (the loop ``planner_node``
 runs) gets the simulator's odometry and the scans that the fault model
 delivers, on simulated time: staleness stops, the progress checker and the
 goal states apply as in the node. Its command goes to the simulated base (no
@@ -18,12 +18,13 @@ import time
 import numpy as np
 
 from ..core.config import PlannerConfig
-from ..core.controller import PlannerController, ScanInput, Supervision
+from ..core.loop import DecisionLoop, Supervision
+from ..core.scan import Scan
 from ..core.status import Outcome, State
 from .faults import FAULT_SEED_OFFSET, ScanDelivery, ScanFaults
 from .metrics import mean_abs_curvature, min_clearance, path_length
 from .outcome import outcome_of
-from .simulator import BurgerSim, Scan, SimConfig
+from .simulator import BurgerSim, SimConfig
 from .world import World
 
 
@@ -66,12 +67,6 @@ class EpisodeResult:
         }
 
 
-def scan_input(scan: Scan) -> ScanInput:
-    """The simulator's sweep as the decision loop takes it (stamp = capture time)."""
-    return ScanInput(scan.ranges, scan.angle_min, scan.angle_increment, scan.range_min,
-                     scan.range_max, scan.stamp)
-
-
 def run_episode(world: World, cfg: PlannerConfig, sim_cfg: SimConfig | None = None,
                 time_limit: float | None = None, faults: ScanFaults | None = None,
                 limits: Supervision | None = None, label: str | None = None) -> EpisodeResult:
@@ -82,7 +77,7 @@ def run_episode(world: World, cfg: PlannerConfig, sim_cfg: SimConfig | None = No
     delivery: ScanDelivery[Scan] = ScanDelivery(faults or ScanFaults(),
                                                 sim_cfg.seed + FAULT_SEED_OFFSET)
     cfg = cfg.replace(goal_tolerance=min(cfg.goal_tolerance, world.goal_tolerance))
-    ctl = PlannerController(cfg, limits)
+    ctl = DecisionLoop(cfg, limits)
     ctl.set_goal(np.asarray(world.goal, float))
     path, plan_ms, recomputed, statuses = [], [], [], {}
     with BurgerSim(world, sim_cfg) as sim:
@@ -99,13 +94,12 @@ def run_episode(world: World, cfg: PlannerConfig, sim_cfg: SimConfig | None = No
             ctl.update_odom(now, odom, now)
             delivery.capture(sim.scan(), now)
             for scan in delivery.due(now):
-                ctl.update_scan(scan_input(scan), now)
-            computations = ctl.planner.memory.computations
+                ctl.update_scan(scan, now)
             t0 = time.perf_counter()
             decision = ctl.tick(now)
             if decision.result is not None:
                 plan_ms.append((time.perf_counter() - t0) * 1e3)
-                recomputed.append(ctl.planner.memory.computations > computations)
+                recomputed.append(decision.result.new_field)
             key = str(decision.result.command.status) if decision.result is not None \
                 else decision.text
             statuses[key] = statuses.get(key, 0) + 1

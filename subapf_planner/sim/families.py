@@ -102,17 +102,17 @@ class Layout:
 # --------------------------------------------------------------------------- draws
 
 
-def _q(v: float) -> float:
+def _on_grid(v: float) -> float:
     """``v`` on the STEP grid [m]."""
     return round(round(v / STEP) * STEP, 4) + 0.0
 
 
-def _u(rng: np.random.Generator, lo: float, hi: float) -> float:
+def _draw(rng: np.random.Generator, lo: float, hi: float) -> float:
     """Uniform draw on the STEP grid in [lo, hi]; the grid point nearest the middle
     when the interval holds none."""
     a, b = math.ceil(lo / STEP - 1e-9), math.floor(hi / STEP + 1e-9)
     if a > b:
-        return _q((lo + hi) / 2)
+        return _on_grid((lo + hi) / 2)
     return round(int(rng.integers(a, b + 1)) * STEP, 4) + 0.0
 
 
@@ -186,8 +186,8 @@ def _door(rng: np.random.Generator, lo: float, hi: float, width: tuple[float, fl
           margin: float) -> tuple[float, float]:
     """A door (a, b) of a width drawn in ``width`` on the wall [lo, hi], at least
     ``margin`` from both ends [m]."""
-    w = _u(rng, *width)
-    c = _u(rng, lo + margin + w / 2, hi - margin - w / 2)
+    w = _draw(rng, *width)
+    c = _draw(rng, lo + margin + w / 2, hi - margin - w / 2)
     return c - w / 2, c + w / 2
 
 
@@ -197,8 +197,8 @@ def _door(rng: np.random.Generator, lo: float, hi: float, width: tuple[float, fl
 def _barn(rng: np.random.Generator, r: FamilyRanges) -> Layout:
     n, cell = r.barn_cells, r.barn_cell
     side = n * cell
-    fill = _u(rng, *r.barn_fill)
-    sigma = _u(rng, *r.barn_smoothing)
+    fill = _draw(rng, *r.barn_fill)
+    sigma = _draw(rng, *r.barn_smoothing)
     noise = ndimage.gaussian_filter(rng.standard_normal((n, n)), sigma, mode='reflect')
     filled = np.argsort(noise, axis=None, kind='stable')[::-1][:round(fill * n * n)]
     occ = np.zeros(n * n, bool)
@@ -207,21 +207,22 @@ def _barn(rng: np.random.Generator, r: FamilyRanges) -> Layout:
     boxes = tuple(_box(c0 * cell, r0 * cell, c1 * cell, r1 * cell)
                   for r0, r1, c0, c1 in _rectangles(occ))
     m = r.barn_margin
-    return Layout((-m / 2, _u(rng, 0.5, side - 0.5)), (side + m / 2, _u(rng, 0.5, side - 0.5)),
-                   (-m, 0.0, side + m, side), boxes,
-                   f'{n}x{n} cells of {cell} m, fill {fill:.2f}, smoothing {sigma:.2f} cells')
+    return Layout((-m / 2, _draw(rng, 0.5, side - 0.5)),
+                  (side + m / 2, _draw(rng, 0.5, side - 0.5)),
+                  (-m, 0.0, side + m, side), boxes,
+                  f'{n}x{n} cells of {cell} m, fill {fill:.2f}, smoothing {sigma:.2f} cells')
 
 
 def _forest(rng: np.random.Generator, r: FamilyRanges) -> Layout:
-    lx, ly = _u(rng, *r.forest_size[0]), _u(rng, *r.forest_size[1])
-    cover = _u(rng, *r.forest_cover)
-    start, goal = (0.5, _u(rng, 0.5, ly - 0.5)), (lx - 0.5, _u(rng, 0.5, ly - 0.5))
+    lx, ly = _draw(rng, *r.forest_size[0]), _draw(rng, *r.forest_size[1])
+    cover = _draw(rng, *r.forest_cover)
+    start, goal = (0.5, _draw(rng, 0.5, ly - 0.5)), (lx - 0.5, _draw(rng, 0.5, ly - 0.5))
     discs, area = [], 0.0
     for _ in range(1000):
         if area >= cover * lx * ly:
             break
-        rad = _u(rng, *r.forest_radius)
-        x, y = _u(rng, 0.0, lx), _u(rng, 0.0, ly)
+        rad = _draw(rng, *r.forest_radius)
+        x, y = _draw(rng, 0.0, lx), _draw(rng, 0.0, ly)
         if min(math.dist((x, y), start), math.dist((x, y), goal)) < rad + 0.5:
             continue
         discs.append(circle(x, y, rad))
@@ -231,17 +232,17 @@ def _forest(rng: np.random.Generator, r: FamilyRanges) -> Layout:
 
 
 def _doorway(rng: np.random.Generator, r: FamilyRanges) -> Layout:
-    lx, ly = _u(rng, *r.doorway_room[0]), _u(rng, *r.doorway_room[1])
-    t = _u(rng, *r.wall_thickness)
-    xw = _u(rng, 0.4 * lx, 0.6 * lx)
-    w = _u(rng, *r.doorway_width)
-    start, goal = (0.6, _u(rng, 0.6, ly - 0.6)), (lx - 0.6, _u(rng, 0.6, ly - 0.6))
+    lx, ly = _draw(rng, *r.doorway_room[0]), _draw(rng, *r.doorway_room[1])
+    t = _draw(rng, *r.wall_thickness)
+    xw = _draw(rng, 0.4 * lx, 0.6 * lx)
+    w = _draw(rng, *r.doorway_width)
+    start, goal = (0.6, _draw(rng, 0.6, ly - 0.6)), (lx - 0.6, _draw(rng, 0.6, ly - 0.6))
     lo, hi = 0.3 + w / 2, ly - 0.3 - w / 2
     if rng.random() < r.doorway_on_line:
         on_line = start[1] + (goal[1] - start[1]) * (xw - start[0]) / (goal[0] - start[0])
-        c = min(max(_q(on_line), _q(lo + STEP / 2)), _q(hi - STEP / 2))
+        c = min(max(_on_grid(on_line), _on_grid(lo + STEP / 2)), _on_grid(hi - STEP / 2))
     else:
-        c = _u(rng, lo, hi)
+        c = _draw(rng, lo, hi)
     walls = (_box(xw - t / 2, 0.0, xw + t / 2, c - w / 2),
              _box(xw - t / 2, c + w / 2, xw + t / 2, ly))
     return Layout(start, goal, (0.0, 0.0, lx, ly), walls,
@@ -249,13 +250,13 @@ def _doorway(rng: np.random.Generator, r: FamilyRanges) -> Layout:
 
 
 def _zigzag(rng: np.random.Generator, r: FamilyRanges) -> Layout:
-    w = _u(rng, *r.corridor_width)
+    w = _draw(rng, *r.corridor_width)
     turns = int(rng.integers(r.zigzag_turns[0], r.zigzag_turns[1] + 1))
     side = 1.0 if rng.random() < 0.5 else -1.0
     pts = [(0.0, 0.0)]
     for k in range(turns + 1):
         x, y = pts[-1]
-        leg = _u(rng, *r.zigzag_leg)
+        leg = _draw(rng, *r.zigzag_leg)
         if k % 2 == 0:
             pts.append((x + leg, y))
         else:
@@ -283,24 +284,25 @@ def _trap_ends(rng: np.random.Generator, r: FamilyRanges, mouth: float, bottom: 
     mouth, goal behind its bottom, both within ``half`` of the axis [m]."""
     inside = rng.random() < r.trap_inside
     if inside:
-        x = _u(rng, mouth + 0.35, bottom - 0.35)
+        x = _draw(rng, mouth + 0.35, bottom - 0.35)
     else:
-        x = _u(rng, mouth - 1.5, mouth - 0.5)
-    start = (x, _u(rng, -half, half))
-    goal = (bottom + _u(rng, 0.6, 1.8), _u(rng, -half, half))
+        x = _draw(rng, mouth - 1.5, mouth - 0.5)
+    start = (x, _draw(rng, -half, half))
+    goal = (bottom + _draw(rng, 0.6, 1.8), _draw(rng, -half, half))
     return start, goal, 'inside' if inside else 'in front'
 
 
 def _trap_bounds(rng: np.random.Generator, start: tuple[float, float],
                  goal: tuple[float, float], mouth: float,
                  half_width: float) -> tuple[float, float, float, float]:
-    side = half_width + _u(rng, 1.0, 1.8)
-    return (_q(min(start[0], mouth) - _u(rng, 0.8, 1.5)), -side, _q(goal[0] + 0.6), side)
+    side = half_width + _draw(rng, 1.0, 1.8)
+    return (_on_grid(min(start[0], mouth) - _draw(rng, 0.8, 1.5)), -side,
+            _on_grid(goal[0] + 0.6), side)
 
 
 def _u_trap(rng: np.random.Generator, r: FamilyRanges) -> Layout:
-    depth, width = _u(rng, *r.trap_depth), _u(rng, *r.trap_width)
-    t = _u(rng, *r.wall_thickness)
+    depth, width = _draw(rng, *r.trap_depth), _draw(rng, *r.trap_width)
+    t = _draw(rng, *r.wall_thickness)
     hw = width / 2
     walls = (_box(-t / 2, -hw - t / 2, t / 2, hw + t / 2),
              _box(-depth, -hw - t / 2, 0.0, -hw + t / 2),
@@ -311,9 +313,9 @@ def _u_trap(rng: np.random.Generator, r: FamilyRanges) -> Layout:
 
 
 def _c_trap(rng: np.random.Generator, r: FamilyRanges) -> Layout:
-    depth, width = _u(rng, *r.trap_depth), _u(rng, *r.trap_width)
-    t = _u(rng, *r.wall_thickness)
-    phi = math.radians(_u(rng, *r.c_trap_arc))
+    depth, width = _draw(rng, *r.trap_depth), _draw(rng, *r.trap_width)
+    t = _draw(rng, *r.wall_thickness)
+    phi = math.radians(_draw(rng, *r.c_trap_arc))
     a, b = depth / (1.0 - math.cos(phi)), width / 2
     theta = np.linspace(-phi, phi, 721)
     xy = np.column_stack((a * np.cos(theta), b * np.sin(theta)))
@@ -335,10 +337,10 @@ def _c_trap(rng: np.random.Generator, r: FamilyRanges) -> Layout:
 
 def _maze(rng: np.random.Generator, r: FamilyRanges) -> Layout:
     rows, cols = (int(v) for v in rng.integers(r.maze_rooms[0], r.maze_rooms[1] + 1, size=2))
-    xs = np.concatenate(([0.0], np.cumsum([_u(rng, *r.room_size) for _ in range(cols)])))
-    ys = np.concatenate(([0.0], np.cumsum([_u(rng, *r.room_size) for _ in range(rows)])))
-    xs, ys = [_q(v) for v in xs], [_q(v) for v in ys]
-    t = _u(rng, *r.wall_thickness)
+    xs = np.concatenate(([0.0], np.cumsum([_draw(rng, *r.room_size) for _ in range(cols)])))
+    ys = np.concatenate(([0.0], np.cumsum([_draw(rng, *r.room_size) for _ in range(rows)])))
+    xs, ys = [_on_grid(v) for v in xs], [_on_grid(v) for v in ys]
+    t = _draw(rng, *r.wall_thickness)
     edges = [((j, i), (j, i + 1)) for j in range(rows) for i in range(cols - 1)] \
         + [((j, i), (j + 1, i)) for j in range(rows - 1) for i in range(cols)]
     parent = {(j, i): (j, i) for j in range(rows) for i in range(cols)}
@@ -370,7 +372,7 @@ def _maze(rng: np.random.Generator, r: FamilyRanges) -> Layout:
                   for a, b in _solid(xs[0], xs[-1], doors.get(('h', k), []))]
 
     def spot(lo: float, hi: float) -> float:
-        return _u(rng, lo + 0.5, hi - 0.5)
+        return _draw(rng, lo + 0.5, hi - 0.5)
     start = (spot(xs[0], xs[1]), spot(ys[0], ys[1]))
     goal = (spot(xs[-2], xs[-1]), spot(ys[-2], ys[-1]))
     return Layout(start, goal, (xs[0], ys[0], xs[-1], ys[-1]), tuple(walls),
@@ -378,17 +380,17 @@ def _maze(rng: np.random.Generator, r: FamilyRanges) -> Layout:
 
 
 def _long_walk(rng: np.random.Generator, r: FamilyRanges) -> Layout:
-    walk, ly = _u(rng, *r.walk_length), _u(rng, *r.walk_width)
-    t = _u(rng, *r.wall_thickness)
+    walk, ly = _draw(rng, *r.walk_length), _draw(rng, *r.walk_width)
+    t = _draw(rng, *r.wall_thickness)
     end = r.walk_end
-    total = _q(walk + 2 * end)
+    total = _on_grid(walk + 2 * end)
     n = max(2, math.ceil(total / r.walk_room))
-    xs = [_q(k * total / n + rng.uniform(-0.3, 0.3)) for k in range(1, n)]
+    xs = [_on_grid(k * total / n + rng.uniform(-0.3, 0.3)) for k in range(1, n)]
     walls = []
     for x in xs:
         for a, b in _solid(0.0, ly, [_door(rng, 0.0, ly, r.door_width, r.door_margin)]):
             walls.append(_box(x - t / 2, a, x + t / 2, b))
-    start, goal = (end, _u(rng, 0.5, ly - 0.5)), (total - end, _u(rng, 0.5, ly - 0.5))
+    start, goal = (end, _draw(rng, 0.5, ly - 0.5)), (total - end, _draw(rng, 0.5, ly - 0.5))
     return Layout(start, goal, (0.0, 0.0, total, ly), tuple(walls),
                    f'{n} rooms in a row, {total:.2f} x {ly:.2f} m')
 

@@ -17,7 +17,8 @@ def path_length(path: np.ndarray) -> float:
 
 
 def min_clearance(world: World, path: np.ndarray) -> float:
-    """Smallest gap between the footprint (radius 0.105 m) and an obstacle surface [m]."""
+    """Smallest gap between the footprint (FOOTPRINT_RADIUS, the burger's) and an
+    obstacle surface [m]."""
     if len(path) == 0:
         return math.nan
     return min(world.clearance(float(x), float(y)) for x, y in path[:, :2]) - FOOTPRINT_RADIUS

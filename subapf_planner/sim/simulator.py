@@ -27,13 +27,13 @@ import pybullet
 from pybullet_utils.bullet_client import BulletClient
 
 from ..core.params import ConfigError, check_fields, param
+from ..core.robot import BURGER, compose
+from ..core.scan import Scan
 from .world import Box, Circle, World
 
 OBSTACLE_HEIGHT = 0.5
-WHEEL_RADIUS = 0.033
-WHEEL_SEPARATION = 0.160
-#: base_scan in base_footprint (base_link is 0.010 m above base_footprint).
-LASER_OFFSET = (-0.032, 0.0, 0.182)
+#: The robot the URDF models (test/test_robot.py checks the two agree).
+ROBOT = BURGER
 
 
 @contextlib.contextmanager
@@ -65,10 +65,10 @@ class SimConfig:
                                 0.0, 1.0, read_only=True)
     odom_noise: float = param(0.0, 'Relative odometry drift per step', '', 0.0, 1.0,
                               read_only=True)
-    max_linear_velocity: float = param(0.22, 'Base speed limit', 'm/s', 0.0, 5.0,
-                                       read_only=True)
-    max_angular_velocity: float = param(2.84, 'Base turn-rate limit', 'rad/s', 0.0, 20.0,
-                                        read_only=True)
+    max_linear_velocity: float = param(ROBOT.max_linear_velocity, 'Base speed limit', 'm/s',
+                                       0.0, 5.0, read_only=True)
+    max_angular_velocity: float = param(ROBOT.max_angular_velocity, 'Base turn-rate limit',
+                                        'rad/s', 0.0, 20.0, read_only=True)
     wheel_torque: float = param(0.5, 'Wheel motor torque limit', 'N m', 1e-3, 100.0,
                                 read_only=True)
     cmd_timeout: float = param(0.5, 'Base watchdog: zero velocity after this without a '
@@ -80,18 +80,6 @@ class SimConfig:
         if self.range_min >= self.range_max:
             raise ConfigError(f'range_min: {self.range_min} must be below range_max '
                               f'{self.range_max}')
-
-
-@dataclass(frozen=True)
-class Scan:
-    """One lidar sweep in base_scan; ranges [m], +inf for no return."""
-
-    stamp: float
-    ranges: np.ndarray
-    angle_min: float
-    angle_increment: float
-    range_min: float
-    range_max: float
 
 
 class BurgerSim:
@@ -176,8 +164,8 @@ class BurgerSim:
         v, w = self._cmd
         if self.time - self._cmd_time > self.config.cmd_timeout:
             v, w = 0.0, 0.0
-        left = (v - w * WHEEL_SEPARATION / 2) / WHEEL_RADIUS
-        right = (v + w * WHEEL_SEPARATION / 2) / WHEEL_RADIUS
+        left = (v - w * ROBOT.wheel_separation / 2) / ROBOT.wheel_radius
+        right = (v + w * ROBOT.wheel_separation / 2) / ROBOT.wheel_radius
         self._client.setJointMotorControlArray(
             self.robot, list(self._wheels), pybullet.VELOCITY_CONTROL,
             targetVelocities=[left, right], forces=[self.config.wheel_torque] * 2)
@@ -231,15 +219,13 @@ class BurgerSim:
         return self._odom.copy(), self.true_velocity()
 
     def scan(self) -> Scan:
-        """One LDS-01-like sweep from base_scan at the current pose."""
+        """One LDS-01-like sweep from base_scan at the current pose (+inf: no return)."""
         cfg = self.config
-        x, y, yaw = self.true_pose()
-        c, s = math.cos(yaw), math.sin(yaw)
-        ox = x + c * LASER_OFFSET[0] - s * LASER_OFFSET[1]
-        oy = y + s * LASER_OFFSET[0] + c * LASER_OFFSET[1]
-        a = self._angles + yaw
+        pose = self.true_pose()
+        ox, oy, _ = compose(pose, ROBOT.laser.planar)
+        a = self._angles + pose[2]
         n = a.size
-        origin = np.tile([ox, oy, LASER_OFFSET[2]], (n, 1))
+        origin = np.tile([ox, oy, ROBOT.laser.z], (n, 1))
         ends = origin + cfg.range_max * np.column_stack((np.cos(a), np.sin(a), np.zeros(n)))
         hits = self._client.rayTestBatch(origin.tolist(), ends.tolist())
         frac = np.array([h[2] if h[0] >= 0 else np.inf for h in hits])
@@ -249,4 +235,5 @@ class BurgerSim:
         if cfg.beam_dropout > 0.0:
             ranges[self._rng.random(n) < cfg.beam_dropout] = np.inf
         ranges[(ranges < cfg.range_min) | (ranges >= cfg.range_max)] = np.inf
-        return Scan(self.time, ranges, 0.0, 2.0 * math.pi / n, cfg.range_min, cfg.range_max)
+        return Scan(ranges, 0.0, 2.0 * math.pi / n, cfg.range_min, cfg.range_max,
+                    stamp=self.time)

@@ -2,7 +2,8 @@
 
 The obstacles' exact signed distance is sampled at the centres of a
 GRID_RESOLUTION m grid; a cell is free when that distance is at least the
-disc's radius (SOLVE_RADIUS: the burger's 0.105 m plus 0.05 m). A world is
+disc's radius (SOLVE_RADIUS: RobotDescription.solve_radius of the burger, its
+0.105 m plus 0.05 m). A world is
 solvable when the start's cell reaches the goal's through 4-connected free
 cells; its geodesic length is the shortest 8-connected path through them
 (scipy's Dijkstra; at most 8 % longer than the true shortest path). Pure numpy
@@ -19,13 +20,12 @@ from scipy import ndimage
 from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import dijkstra
 
+from ..core.robot import BURGER
 from .world import Box, Circle, Obstacle, World, parse_world
 
-#: Body radius of the burger [m] and the margin the solvability check adds to it [m].
-ROBOT_RADIUS = 0.105
-SOLVE_MARGIN = 0.05
-#: Radius of the disc that must fit through every world [m].
-SOLVE_RADIUS = ROBOT_RADIUS + SOLVE_MARGIN
+#: Radius of the disc that must fit through every world [m] (the burger's footprint plus
+#: core.robot.SOLVE_MARGIN).
+SOLVE_RADIUS = BURGER.solve_radius
 #: Cell size of the solvability and geodesic grid [m].
 GRID_RESOLUTION = 0.05
 

@@ -16,13 +16,15 @@ from typing import Any
 import numpy as np
 import yaml
 
+from ..core.robot import BURGER
+
 FORMAT_KEYS = {'name', 'description', 'start', 'goal', 'goal_tolerance', 'time_limit',
                'bounds', 'obstacles'}
 REQUIRED_KEYS = ('name', 'start', 'goal')
 #: Thickness of the walls made from ``bounds`` [m].
 WALL_THICKNESS = 0.1
 #: Footprint radius used to reject a start or goal inside an obstacle [m].
-FOOTPRINT_RADIUS = 0.105
+FOOTPRINT_RADIUS = BURGER.radius
 
 
 class WorldError(ValueError):

@@ -75,7 +75,7 @@ def _turn(x: float, y: float, k: int, flip: bool) -> tuple[float, float]:
     return x, y
 
 
-def _r(v: float) -> float:
+def _as_written(v: float) -> float:
     """A coordinate as written [m or rad]: 4 decimals, no -0.0."""
     return round(float(v), 4) + 0.0
 
@@ -88,33 +88,33 @@ def _document(layout: Layout, rng: np.random.Generator, name: str) -> dict[str, 
 
     def point(x: float, y: float) -> list[float]:
         px, py = _turn(x, y, k, flip)
-        return [_r(px - sx), _r(py - sy)]
+        return [_as_written(px - sx), _as_written(py - sy)]
     obstacles = []
     for o in layout.obstacles:
         if 'circle' in o:
             c = o['circle']
-            obstacles.append(circle(*point(*c['center']), _r(c['radius'])))
+            obstacles.append(circle(*point(*c['center']), _as_written(c['radius'])))
             continue
         b = o['box']
         size, yaw = list(b['size']), float(b.get('yaw', 0.0))
         if yaw == 0.0:
             if k % 2:
                 size.reverse()
-            spec = {'center': point(*b['center']), 'size': [_r(v) for v in size]}
+            spec = {'center': point(*b['center']), 'size': [_as_written(v) for v in size]}
         else:
             yaw = (-yaw if flip else yaw) + k * math.pi / 2
             yaw = math.atan2(math.sin(yaw), math.cos(yaw))
-            spec = {'center': point(*b['center']), 'size': [_r(v) for v in size],
-                    'yaw': _r(yaw)}
+            spec = {'center': point(*b['center']), 'size': [_as_written(v) for v in size],
+                    'yaw': _as_written(yaw)}
         obstacles.append({'box': spec})
     x0, y0, x1, y1 = layout.bounds
     corners = np.array([point(x0, y0), point(x1, y1)])
     goal = point(*layout.goal)
     heading = math.atan2(goal[1], goal[0]) + rng.uniform(-math.pi / 6, math.pi / 6)
     heading = math.atan2(math.sin(heading), math.cos(heading))
-    return {'name': name, 'description': layout.note, 'start': [0.0, 0.0, _r(heading)],
+    return {'name': name, 'description': layout.note, 'start': [0.0, 0.0, _as_written(heading)],
             'goal': goal, 'goal_tolerance': GOAL_TOLERANCE, 'time_limit': BASE_TIME,
-            'bounds': [_r(v) for v in (*corners.min(axis=0), *corners.max(axis=0))],
+            'bounds': [_as_written(v) for v in (*corners.min(axis=0), *corners.max(axis=0))],
             'obstacles': obstacles}
 
 

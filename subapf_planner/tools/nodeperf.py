@@ -14,6 +14,7 @@
 from __future__ import annotations
 
 import argparse
+from dataclasses import replace
 import os
 from pathlib import Path
 import random
@@ -78,9 +79,7 @@ def planner_figures(seconds: float, domain: int) -> dict[str, float]:
                 odom_pub.publish(odom_to_msg(pose, (0.0, 0.0), stamp))
                 next_odom += 0.05
             if now >= next_scan:
-                scan_pub.publish(scan_to_msg(scan.ranges, scan.angle_min, scan.angle_increment,
-                                             scan.range_min, scan.range_max, stamp,
-                                             'base_scan'))
+                scan_pub.publish(scan_to_msg(replace(scan, stamp=stamp), 'base_scan'))
                 next_scan += 0.2
             rclpy.spin_once(node, timeout_sec=0.005)
         cycles = len(latencies)

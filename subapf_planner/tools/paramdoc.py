@@ -16,7 +16,7 @@ import textwrap
 import yaml
 
 from ..core.config import PlannerConfig
-from ..core.controller import Supervision
+from ..core.loop import Supervision
 from ..sim.faults import ScanFaults
 from ..sim.simulator import SimConfig
 
@@ -60,7 +60,7 @@ def render() -> str:
     from ..ros.planner_node import NodeOptions
     from ..ros.sim_node import SimNodeOptions
     planner = _section('subapf_planner', [('node (ros/planner_node.py)', NodeOptions),
-                                          ('supervision (core/controller.py)', Supervision),
+                                          ('supervision (core/loop.py)', Supervision),
                                           ('planner core (core/config.py)', PlannerConfig)])
     sim = _section('subapf_sim', [('node (ros/sim_node.py)', SimNodeOptions),
                                   ('simulator (sim/simulator.py)', SimConfig),

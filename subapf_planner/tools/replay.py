@@ -1,83 +1,38 @@
 """``subapf-replay``: feed a recorded run through the planner and compare its cmd_vel.
 
-The recorded ``scan``, ``odom`` and ``goal_pose`` go through the same
-``PlannerController`` the node runs, in simulated time order (as fast as possible;
-the event stream of bag/events.py, which the DDS replay reads too); at each
-recorded ``cmd_vel`` the controller ticks, as the node's timer did: at its stamp
-(TwistStamped) or, for a Twist bag, at the simulated time it was recorded at.
-Prints count, max and mean |dv| and |dw| and the first divergence; exit 0 when
-max |dv| and |dw| are within ``--tolerance``, 1 when not, 2 for an unusable bag or
-parameters.
+In process (ros/replay.py: the node's input checks and decision loop over the
+bag's events) or, with ``--through-node``, through a planner_node process over
+DDS (ros/replay_dds.py). Prints count, max and mean |dv| and |dw| and the first
+divergence; exit 0 when max |dv| and |dw| are within ``--tolerance``, 1 when not,
+2 for an unusable bag or parameters.
 """
 
 from __future__ import annotations
 
 import argparse
-import math
 import random
 import sys
 
 import numpy as np
 
 from ..bag.comparison import Comparison
-from ..bag.events import STAMPED_CMD, events
+from ..bag.events import STAMPED_CMD
 from ..bag.reader import BagError
 from ..bag.writer import McapRecorder
-from ..core.config import METHODS, ConfigError, PlannerConfig, load_config, load_params_file
-from ..core.controller import PlannerController, Supervision
+from ..core.config import METHODS, ConfigError, load_config, load_params_file
+from ..core.loop import Supervision
 from ..core.params import build
-from ..ros.conversions import (
-    cmd_from_msg,
-    cmd_to_msg,
-    pose_from_odom,
-    scan_from_msg,
-    stamp_to_seconds,
-)
+from ..ros.conversions import cmd_to_msg, seconds_to_stamp
+from ..ros.intake import Intake
 from ..ros.paths import default_params_file
-
-
-def replay(path: str, cfg: PlannerConfig, limits: Supervision,
-           names: dict[str, str]) -> Comparison:
-    """Run the controller over the bag's events (bag/events.py); see the module
-    docstring. Arguments to the controller as planner_node passes them: odometry with
-    its stamp, every input with the time it is handled at."""
-    ctl = PlannerController(cfg, limits)
-    times, recorded, replayed = [], [], []
-    skipped = 0
-    for e in events(path, names):
-        t = e.time
-        if e.role == 'scan':
-            ctl.update_scan(scan_from_msg(e.message), t)
-        elif e.role == 'odom':
-            pose = pose_from_odom(e.message)
-            if np.all(np.isfinite(pose)):
-                ctl.update_odom(stamp_to_seconds(e.message.header.stamp), pose, t)
-        elif e.role == 'goal':
-            p = e.message.pose.position
-            goal = np.array([p.x, p.y], float)
-            if np.all(np.isfinite(goal)):
-                ctl.set_goal(goal)
-        else:
-            command = cmd_from_msg(e.message)
-            leading = skipped == len(replayed) and (ctl.scan is None or ctl.pose is None
-                                                    or ctl.goal is None)
-            decision = ctl.tick(t)
-            if leading:
-                skipped += 1
-                ctl.planner.previous = command   # the node's state after what it published
-            times.append(t)
-            recorded.append(command)
-            replayed.append(decision.command if decision.command is not None
-                            else (math.nan, math.nan))
-    return Comparison(np.asarray(times), np.asarray(recorded, float).reshape(-1, 2),
-                      np.asarray(replayed, float).reshape(-1, 2), skipped)
+from ..ros.planner_node import NodeOptions
+from ..ros.replay import replay
 
 
 def write_commands(out: str, comparison: Comparison) -> None:
     """The replayed commands as /cmd_vel (TwistStamped) in an MCAP file."""
     from rclpy.serialization import serialize_message
 
-    from ..ros.conversions import seconds_to_stamp
     rec = McapRecorder(out)
     try:
         rec.add_topic('/cmd_vel', STAMPED_CMD)
@@ -109,7 +64,9 @@ def main(argv: list[str] | None = None) -> int:
     try:
         params = args.params or default_params_file()
         cfg = load_config(params, method=args.method)
-        limits = build(Supervision, load_params_file(params), ignore_unknown=True)
+        values = load_params_file(params)
+        limits = build(Supervision, values, ignore_unknown=True)
+        options = build(NodeOptions, values, ignore_unknown=True)
         names = {'scan': args.scan_topic, 'odom': args.odom_topic, 'goal': args.goal_topic,
                  'cmd_vel': args.cmd_topic}
         if args.through_node:
@@ -117,7 +74,8 @@ def main(argv: list[str] | None = None) -> int:
             domain = args.domain_id if args.domain_id is not None else random.randint(1, 100)
             comparison = replay_through_node(args.bag, str(params), names, args.method, domain)
         else:
-            comparison = replay(args.bag, cfg, limits, names)
+            comparison = replay(args.bag, cfg, limits, names,
+                                Intake(options.laser_frame, options.odom_frame))
     except (BagError, ConfigError) as exc:
         print(f'subapf-replay: {exc}', file=sys.stderr)
         return 2

@@ -1,10 +1,12 @@
 """The decision loop, without ROS: input freshness, goal, progress, states.
 
 One loop for everything that plans: ``planner_node`` feeds it messages as
-arrays with their times and publishes what ``tick`` decides; ``subapf-replay``
-feeds it a recorded bag the same way; the benchmark's episode (sim/episode.py)
-feeds it the simulator's scans and odometry on simulated time. Times are
-seconds on the node's clock (simulated time under ``use_sim_time``).
+arrays with their times and publishes what ``tick`` decides; the replay
+(ros/replay.py) feeds it a recorded bag the same way; the benchmark's episode
+(sim/episode.py) feeds it the simulator's scans and odometry on simulated time.
+Times are seconds on the node's clock (simulated time under ``use_sim_time``).
+Each ``tick`` supervises (goal, freshness, progress) and runs one planning step
+(core/planner.py: perceive, gate, plan).
 
 States (:class:`~.status.State`, the text of ``~/status`` before the colon):
 idle, waiting, driving, reached, stopped, stuck.
@@ -19,8 +21,10 @@ import numpy as np
 
 from .config import PlannerConfig
 from .memory import SAME_GOAL
+from .occupancy import OccupancyGrid
 from .params import check_fields, param
 from .planner import Planner, PlanResult
+from .scan import Scan
 from .status import State, Status
 
 #: Odometry poses kept to place each scan at the pose it was taken from.
@@ -48,18 +52,6 @@ class Supervision:
 
 
 @dataclass(frozen=True)
-class ScanInput:
-    """A scan's arrays and stamp [s] (see conversions.ScanArrays)."""
-
-    ranges: np.ndarray
-    angle_min: float
-    angle_increment: float
-    range_min: float
-    range_max: float
-    stamp: float
-
-
-@dataclass(frozen=True)
 class Decision:
     """What to publish: a command (None: publish nothing), the state and its reason,
     the plan if any."""
@@ -70,18 +62,28 @@ class Decision:
     result: PlanResult | None = None
 
     @property
+    def grid(self) -> OccupancyGrid:
+        """The occupancy memory (read it, do not change it)."""
+        return self.planner.memory.grid
+
+    def seed_command(self, command: tuple[float, float]) -> None:
+        """The command the robot was last sent by someone else (a replay that starts
+        mid-run): the next command's acceleration limits start from it."""
+        self.planner.previous = (float(command[0]), float(command[1]))
+
+    @property
     def text(self) -> str:
         """``~/status`` on the wire: ``"state: reason"``."""
         return f'{self.state}: {self.reason}'
 
 
-class PlannerController:
-    """One robot's planning loop state. Not thread-safe; call from one executor."""
+class DecisionLoop:
+    """One robot's decision loop and its state. Not thread-safe; call from one executor."""
 
     def __init__(self, cfg: PlannerConfig, limits: Supervision | None = None) -> None:
         self.planner = Planner(cfg)
         self.limits = limits or Supervision()
-        self.scan: ScanInput | None = None
+        self.scan: Scan | None = None
         self.scan_time: float | None = None
         self.pose: np.ndarray | None = None
         self.odom_time: float | None = None
@@ -98,6 +100,16 @@ class PlannerController:
     @cfg.setter
     def cfg(self, cfg: PlannerConfig) -> None:
         self.planner.cfg = cfg
+
+    @property
+    def grid(self) -> OccupancyGrid:
+        """The occupancy memory (read it, do not change it)."""
+        return self.planner.memory.grid
+
+    def seed_command(self, command: tuple[float, float]) -> None:
+        """The command the robot was last sent by someone else (a replay that starts
+        mid-run): the next command's acceleration limits start from it."""
+        self.planner.previous = (float(command[0]), float(command[1]))
 
     @property
     def text(self) -> str:
@@ -128,7 +140,8 @@ class PlannerController:
         if self.goal is not None:
             self._set(State.DRIVING, 'clock jumped')
 
-    def update_scan(self, scan: ScanInput, now: float) -> None:
+    def update_scan(self, scan: Scan, now: float) -> None:
+        """Take a scan (its stamp: capture time), handled at ``now`` [s]."""
         self.scan, self.scan_time = scan, now
 
     def update_odom(self, stamp: float, pose: np.ndarray, now: float) -> bool:
@@ -173,10 +186,8 @@ class PlannerController:
             return self._stop(State.STOPPED, 'odometry is stale')
         if self.state is State.STUCK:
             return Decision((0.0, 0.0), self.state, self.reason)
-        s = self.scan
-        result = self.planner.step_scan(self.pose, self.goal, s.ranges, s.angle_min,
-                                        s.angle_increment, s.range_min, s.range_max,
-                                        self.pose_at(s.stamp), s.stamp, now)
+        result = self.planner.step(self.pose, self.goal, self.scan,
+                                   self.pose_at(self.scan.stamp), now)
         cmd = result.command
         if cmd.status is Status.REACHED:
             self.goal = None

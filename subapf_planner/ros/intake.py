@@ -1,0 +1,65 @@
+"""The planner's inputs from messages, checked once: for planner_node and the replay.
+
+Each function takes one message into a :class:`~subapf_planner.core.loop.DecisionLoop`
+and returns what a person should be told (None: nothing), so the node logs it
+(throttled) and the in-process replay (ros/replay.py) takes the same messages
+in the same way:
+
+* a scan in a frame other than ``laser_frame`` (empty: any) is dropped; a scan
+  whose ranges do not match its header is used (LDS-02 varies its count) with a
+  warning;
+* odometry with a non-finite pose is dropped; a stamp going back in time clears
+  the pose history;
+* a goal in a frame other than ``odom_frame`` (or empty) or with a non-finite
+  position is refused (an error), the previous goal kept.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from geometry_msgs.msg import PoseStamped
+from nav_msgs.msg import Odometry
+import numpy as np
+from sensor_msgs.msg import LaserScan
+
+from ..core.loop import DecisionLoop
+from ..core.scan import geometry_warning
+from .conversions import pose_from_odom, scan_from_msg, stamp_to_seconds
+
+
+@dataclass(frozen=True)
+class Intake:
+    """The frames the inputs must be in (the node's ``laser_frame`` and ``odom_frame``)."""
+
+    laser_frame: str = 'base_scan'
+    odom_frame: str = 'odom'
+
+    def scan(self, loop: DecisionLoop, msg: LaserScan, now: float) -> str | None:
+        """Take a scan handled at ``now`` [s]; a warning, or None."""
+        if self.laser_frame and msg.header.frame_id != self.laser_frame:
+            return (f'scan in frame "{msg.header.frame_id}", expected "{self.laser_frame}": '
+                    'dropped')
+        loop.update_scan(scan_from_msg(msg), now)
+        problem = geometry_warning(len(msg.ranges), msg.angle_min, msg.angle_max,
+                                   msg.angle_increment)
+        return f'scan header: {problem}' if problem else None
+
+    def odom(self, loop: DecisionLoop, msg: Odometry, now: float) -> str | None:
+        """Take odometry handled at ``now`` [s]; a warning, or None."""
+        pose = pose_from_odom(msg)
+        if not np.all(np.isfinite(pose)):
+            return 'odometry with a non-finite pose: dropped'
+        if not loop.update_odom(stamp_to_seconds(msg.header.stamp), pose, now):
+            return 'odometry stamp went back in time: pose history cleared'
+        return None
+
+    def goal(self, loop: DecisionLoop, msg: PoseStamped) -> tuple[bool, str | None]:
+        """Take a goal: (whether it is a new goal, the reason it was refused or None)."""
+        goal = np.array([msg.pose.position.x, msg.pose.position.y], dtype=float)
+        if msg.header.frame_id not in ('', self.odom_frame):
+            return False, (f'goal in frame "{msg.header.frame_id}" refused: give it in '
+                           f'"{self.odom_frame}"')
+        if not np.all(np.isfinite(goal)):
+            return False, 'goal with a non-finite position refused'
+        return loop.set_goal(goal), None
