@@ -130,7 +130,8 @@ def test_command_writes_loadable_files(tmp_path, capsys):
         assert yaml.safe_load(f.read_text()) == docs[world.name]
     text = capsys.readouterr().out
     for family in worldgen.FAMILIES:
-        assert re.search(rf'^{family} +\d+ worlds, +[\d.]+ obstacles, geodesic', text, re.M)
+        assert re.search(rf'^{family} +\d+ worlds, +[\d.]+ obstacles, +[\d.]+ moving, '
+                         'geodesic', text, re.M)
     assert main(['--out', str(tmp_path / 'two'), '--count', '3', '--families',
                  'maze,doorway']) == 0
     assert sorted(p.stem for p in (tmp_path / 'two').glob('*.yaml')) == [

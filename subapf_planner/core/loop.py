@@ -117,11 +117,11 @@ class DecisionLoop:
         return f'{self.state}: {self.reason}'
 
     def set_goal(self, goal: np.ndarray) -> bool:
-        """A new goal resets the planner; the goal being driven to, sent again while
-        driving, does not (a stuck or stopped robot retries it).
-        Returns whether the goal was new."""
+        """A new goal resets the planner; the goal being driven to (or waited for: no
+        inputs yet), sent again, does not, whenever it arrives (a stuck or stopped robot
+        retries it). Returns whether the goal was new."""
         goal = np.asarray(goal, float)
-        if self.goal is not None and self.state is State.DRIVING \
+        if self.goal is not None and self.state in (State.DRIVING, State.WAITING) \
                 and np.hypot(*(goal - self.goal)) < SAME_GOAL:
             return False
         self.goal = goal.copy()

@@ -12,6 +12,7 @@ from visualization_msgs.msg import Marker, MarkerArray
 
 from ..core.planner import PlanResult
 from ..core.scan import voxel_downsample
+from ..sim.world import Box, Circle
 
 
 def _marker(ns: str, mid: int, mtype: int, frame: str, stamp: Time, scale: float,
@@ -67,4 +68,24 @@ def markers_from_result(result: PlanResult, frame: str, stamp: Time,
     ring.points = _points(np.column_stack((position[0] + danger_distance * np.cos(a),
                                            position[1] + danger_distance * np.sin(a))))
     out.markers.append(ring)
+    return out
+
+
+def moving_obstacle_markers(obstacles: tuple[Circle | Box, ...], frame: str,
+                            stamp: Time) -> MarkerArray:
+    """The true outlines of a world's moving obstacles (sim_node's ``moving_obstacles``):
+    a cylinder per circle, a box per box, 0.5 m tall, ids in world order."""
+    out = MarkerArray()
+    for i, o in enumerate(obstacles):
+        kind = Marker.CYLINDER if isinstance(o, Circle) else Marker.CUBE
+        m = _marker('moving_obstacles', i, kind, frame, stamp, 1.0, (1.0, 0.55, 0.0, 0.8))
+        m.pose.position.x, m.pose.position.y = (float(v) for v in o.center)
+        m.pose.position.z = 0.25
+        if isinstance(o, Circle):
+            m.scale.x = m.scale.y = 2.0 * o.radius
+        else:
+            m.scale.x, m.scale.y = (float(v) for v in o.size)
+            m.pose.orientation.z, m.pose.orientation.w = math.sin(o.yaw / 2), math.cos(o.yaw / 2)
+        m.scale.z = 0.5
+        out.markers.append(m)
     return out

@@ -9,6 +9,8 @@ reached, collision or timeout; transient-local, published once). Subscribes
 Physics advances in steps of 50 ms of simulated time on a wall-clock timer,
 ``rate`` times faster than real time. ``/tf`` and ``/tf_static`` go out when
 tf2_msgs is installed (not among the PyPI ROS wheels; odom carries the same pose).
+A world with moving obstacles also gets ``moving_obstacles``
+(visualization_msgs/MarkerArray in odom: where each truly is, at the scan rate).
 """
 
 from __future__ import annotations
@@ -23,6 +25,7 @@ from rclpy.qos import qos_profile_sensor_data
 from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import LaserScan
 from std_msgs.msg import String
+from visualization_msgs.msg import MarkerArray
 
 from ..core.params import ConfigError, check_fields, param
 from ..core.status import Outcome
@@ -37,6 +40,7 @@ from .conversions import (
     seconds_to_stamp,
     transform_msg,
 )
+from .markers import moving_obstacle_markers
 from .parameters import declare, read
 from .qos import LATCHED
 from .spinning import spin_node
@@ -87,6 +91,8 @@ class SimNode(Node):
         self.odom_pub = self.create_publisher(Odometry, 'odom', 10)
         self.truth_pub = self.create_publisher(Odometry, 'ground_truth', 10)
         self.outcome_pub = self.create_publisher(String, 'sim_outcome', LATCHED)
+        self.moving_pub = self.create_publisher(MarkerArray, 'moving_obstacles', 10) \
+            if self.world.moving else None
         self._setup_tf()
         cmd_type = TwistStamped if options.enable_stamped_cmd_vel else Twist
         self.create_subscription(cmd_type, 'cmd_vel', self._on_cmd, 10)
@@ -138,6 +144,9 @@ class SimNode(Node):
         if t + 1e-9 >= self._next_scan:
             self._next_scan += SCAN_PERIOD
             self._scans.capture(scan_to_msg(replace(sim.scan(), stamp=t), 'base_scan'), t)
+            if self.moving_pub is not None:   # where they truly are, at the scan rate
+                self.moving_pub.publish(moving_obstacle_markers(
+                    self.world.moving_at(t), 'odom', seconds_to_stamp(t)))
         # scans go out scan_latency after capture, stamped with their capture time
         for msg in self._scans.due(t):
             self.scan_pub.publish(msg)
@@ -155,7 +164,8 @@ class SimNode(Node):
         self.outcome = outcome_of(self.world, sim.true_pose(), sim.collided, sim.time)
         if self.outcome is not None:
             self.outcome_pub.publish(String(data=str(self.outcome)))
-            self.get_logger().info(f'outcome: {self.outcome} at t={sim.time:.1f} s')
+            stood = ' (hit while stopped)' if sim.collided and sim.hit_while_stopped else ''
+            self.get_logger().info(f'outcome: {self.outcome}{stood} at t={sim.time:.1f} s')
 
 
 def main(args: list[str] | None = None) -> int:

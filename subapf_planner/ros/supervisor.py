@@ -40,6 +40,7 @@ RECORDED = {
     '/subapf_planner/markers': (MarkerArray, _RELIABLE),
     '/subapf_planner/plan': (Path, _RELIABLE),
     '/subapf_planner/map': (OccupancyGrid, _LATCHED_DEEP),
+    '/moving_obstacles': (MarkerArray, _RELIABLE),
 }
 #: Longest the recorder drains its queues on close [s].
 DRAIN_TIMEOUT = 5.0

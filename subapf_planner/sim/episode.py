@@ -42,6 +42,10 @@ class EpisodeResult:
     statuses: dict[str, int] = field(default_factory=dict)
     #: Per planning cycle, whether it computed a new navigation field.
     field_recomputed: np.ndarray = field(default_factory=lambda: np.zeros(0, bool))
+    #: Simulated time of each ``path`` point [s].
+    times: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    #: A collision with the base commanded to stand still (it counts as a collision).
+    hit_while_stopped: bool = False
 
     @property
     def cycles(self) -> int:
@@ -55,7 +59,7 @@ class EpisodeResult:
             'outcome': str(self.outcome),
             'time_s': round(self.time_s, 3),
             'path_length': round(path_length(self.path), 4),
-            'min_clearance': round(min_clearance(world, self.path), 4),
+            'min_clearance': round(min_clearance(world, self.path, self.times), 4),
             'mean_abs_curvature': round(mean_abs_curvature(self.path), 4),
             'plan_ms_median': round(float(np.median(self.plan_ms)), 4) if self.cycles else 0.0,
             'plan_ms_p99': round(float(np.percentile(self.plan_ms, 99)), 4)
@@ -64,6 +68,7 @@ class EpisodeResult:
             'final_distance': round(self.final_distance, 4),
             'goal_tolerance': world.goal_tolerance,
             'statuses': dict(self.statuses),
+            'hit_while_stopped': self.hit_while_stopped,
         }
 
 
@@ -79,11 +84,12 @@ def run_episode(world: World, cfg: PlannerConfig, sim_cfg: SimConfig | None = No
     cfg = cfg.replace(goal_tolerance=min(cfg.goal_tolerance, world.goal_tolerance))
     ctl = DecisionLoop(cfg, limits)
     ctl.set_goal(np.asarray(world.goal, float))
-    path, plan_ms, recomputed, statuses = [], [], [], {}
+    path, times, plan_ms, recomputed, statuses = [], [], [], [], {}
     with BurgerSim(world, sim_cfg) as sim:
         while True:
             truth = sim.true_pose()
             path.append(truth)
+            times.append(sim.time)
             outcome = outcome_of(world, truth, sim.collided, sim.time, time_limit)
             if outcome is None and ctl.state is State.STUCK:
                 outcome = Outcome.ABANDONED
@@ -108,5 +114,7 @@ def run_episode(world: World, cfg: PlannerConfig, sim_cfg: SimConfig | None = No
             sim.step(cfg.period)
         final = float(np.hypot(*(sim.true_pose()[:2] - np.asarray(world.goal, float))))
         elapsed = sim.time
+        hit_while_stopped = outcome is Outcome.COLLISION and sim.hit_while_stopped
     return EpisodeResult(world.name, label or cfg.method, outcome, elapsed, np.asarray(path),
-                         np.asarray(plan_ms), final, statuses, np.asarray(recomputed, bool))
+                         np.asarray(plan_ms), final, statuses, np.asarray(recomputed, bool),
+                         np.asarray(times), hit_while_stopped)

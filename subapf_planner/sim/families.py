@@ -97,26 +97,28 @@ class Layout:
     obstacles: tuple[dict[str, Any], ...]
     note: str
     blocked: bool = False   # the straight start-goal line must cross an obstacle
+    #: Moving obstacles as the world format writes them (sim/dynamic_families.py).
+    moving: tuple[dict[str, Any], ...] = ()
 
 
 # --------------------------------------------------------------------------- draws
 
 
-def _on_grid(v: float) -> float:
+def on_grid(v: float) -> float:
     """``v`` on the STEP grid [m]."""
     return round(round(v / STEP) * STEP, 4) + 0.0
 
 
-def _draw(rng: np.random.Generator, lo: float, hi: float) -> float:
+def draw(rng: np.random.Generator, lo: float, hi: float) -> float:
     """Uniform draw on the STEP grid in [lo, hi]; the grid point nearest the middle
     when the interval holds none."""
     a, b = math.ceil(lo / STEP - 1e-9), math.floor(hi / STEP + 1e-9)
     if a > b:
-        return _on_grid((lo + hi) / 2)
+        return on_grid((lo + hi) / 2)
     return round(int(rng.integers(a, b + 1)) * STEP, 4) + 0.0
 
 
-def _box(x0: float, y0: float, x1: float, y1: float) -> dict[str, Any]:
+def box(x0: float, y0: float, x1: float, y1: float) -> dict[str, Any]:
     """Axis-aligned box from its edges [m]."""
     return {'box': {'center': [(x0 + x1) / 2, (y0 + y1) / 2], 'size': [x1 - x0, y1 - y0]}}
 
@@ -166,7 +168,7 @@ def _carve(bounds: tuple[float, float, float, float],
     occ = np.ones((cy.size, cx.size), bool)
     for fx0, fy0, fx1, fy1 in free:
         occ[np.ix_((cy > fy0) & (cy < fy1), (cx > fx0) & (cx < fx1))] = False
-    return [_box(float(xs[c0]), float(ys[r0]), float(xs[c1]), float(ys[r1]))
+    return [box(float(xs[c0]), float(ys[r0]), float(xs[c1]), float(ys[r1]))
             for r0, r1, c0, c1 in _rectangles(occ)]
 
 
@@ -186,8 +188,8 @@ def _door(rng: np.random.Generator, lo: float, hi: float, width: tuple[float, fl
           margin: float) -> tuple[float, float]:
     """A door (a, b) of a width drawn in ``width`` on the wall [lo, hi], at least
     ``margin`` from both ends [m]."""
-    w = _draw(rng, *width)
-    c = _draw(rng, lo + margin + w / 2, hi - margin - w / 2)
+    w = draw(rng, *width)
+    c = draw(rng, lo + margin + w / 2, hi - margin - w / 2)
     return c - w / 2, c + w / 2
 
 
@@ -197,32 +199,32 @@ def _door(rng: np.random.Generator, lo: float, hi: float, width: tuple[float, fl
 def _barn(rng: np.random.Generator, r: FamilyRanges) -> Layout:
     n, cell = r.barn_cells, r.barn_cell
     side = n * cell
-    fill = _draw(rng, *r.barn_fill)
-    sigma = _draw(rng, *r.barn_smoothing)
+    fill = draw(rng, *r.barn_fill)
+    sigma = draw(rng, *r.barn_smoothing)
     noise = ndimage.gaussian_filter(rng.standard_normal((n, n)), sigma, mode='reflect')
     filled = np.argsort(noise, axis=None, kind='stable')[::-1][:round(fill * n * n)]
     occ = np.zeros(n * n, bool)
     occ[filled] = True
     occ = occ.reshape(n, n)          # row = y, column = x
-    boxes = tuple(_box(c0 * cell, r0 * cell, c1 * cell, r1 * cell)
+    boxes = tuple(box(c0 * cell, r0 * cell, c1 * cell, r1 * cell)
                   for r0, r1, c0, c1 in _rectangles(occ))
     m = r.barn_margin
-    return Layout((-m / 2, _draw(rng, 0.5, side - 0.5)),
-                  (side + m / 2, _draw(rng, 0.5, side - 0.5)),
+    return Layout((-m / 2, draw(rng, 0.5, side - 0.5)),
+                  (side + m / 2, draw(rng, 0.5, side - 0.5)),
                   (-m, 0.0, side + m, side), boxes,
                   f'{n}x{n} cells of {cell} m, fill {fill:.2f}, smoothing {sigma:.2f} cells')
 
 
 def _forest(rng: np.random.Generator, r: FamilyRanges) -> Layout:
-    lx, ly = _draw(rng, *r.forest_size[0]), _draw(rng, *r.forest_size[1])
-    cover = _draw(rng, *r.forest_cover)
-    start, goal = (0.5, _draw(rng, 0.5, ly - 0.5)), (lx - 0.5, _draw(rng, 0.5, ly - 0.5))
+    lx, ly = draw(rng, *r.forest_size[0]), draw(rng, *r.forest_size[1])
+    cover = draw(rng, *r.forest_cover)
+    start, goal = (0.5, draw(rng, 0.5, ly - 0.5)), (lx - 0.5, draw(rng, 0.5, ly - 0.5))
     discs, area = [], 0.0
     for _ in range(1000):
         if area >= cover * lx * ly:
             break
-        rad = _draw(rng, *r.forest_radius)
-        x, y = _draw(rng, 0.0, lx), _draw(rng, 0.0, ly)
+        rad = draw(rng, *r.forest_radius)
+        x, y = draw(rng, 0.0, lx), draw(rng, 0.0, ly)
         if min(math.dist((x, y), start), math.dist((x, y), goal)) < rad + 0.5:
             continue
         discs.append(circle(x, y, rad))
@@ -232,31 +234,31 @@ def _forest(rng: np.random.Generator, r: FamilyRanges) -> Layout:
 
 
 def _doorway(rng: np.random.Generator, r: FamilyRanges) -> Layout:
-    lx, ly = _draw(rng, *r.doorway_room[0]), _draw(rng, *r.doorway_room[1])
-    t = _draw(rng, *r.wall_thickness)
-    xw = _draw(rng, 0.4 * lx, 0.6 * lx)
-    w = _draw(rng, *r.doorway_width)
-    start, goal = (0.6, _draw(rng, 0.6, ly - 0.6)), (lx - 0.6, _draw(rng, 0.6, ly - 0.6))
+    lx, ly = draw(rng, *r.doorway_room[0]), draw(rng, *r.doorway_room[1])
+    t = draw(rng, *r.wall_thickness)
+    xw = draw(rng, 0.4 * lx, 0.6 * lx)
+    w = draw(rng, *r.doorway_width)
+    start, goal = (0.6, draw(rng, 0.6, ly - 0.6)), (lx - 0.6, draw(rng, 0.6, ly - 0.6))
     lo, hi = 0.3 + w / 2, ly - 0.3 - w / 2
     if rng.random() < r.doorway_on_line:
         on_line = start[1] + (goal[1] - start[1]) * (xw - start[0]) / (goal[0] - start[0])
-        c = min(max(_on_grid(on_line), _on_grid(lo + STEP / 2)), _on_grid(hi - STEP / 2))
+        c = min(max(on_grid(on_line), on_grid(lo + STEP / 2)), on_grid(hi - STEP / 2))
     else:
-        c = _draw(rng, lo, hi)
-    walls = (_box(xw - t / 2, 0.0, xw + t / 2, c - w / 2),
-             _box(xw - t / 2, c + w / 2, xw + t / 2, ly))
+        c = draw(rng, lo, hi)
+    walls = (box(xw - t / 2, 0.0, xw + t / 2, c - w / 2),
+             box(xw - t / 2, c + w / 2, xw + t / 2, ly))
     return Layout(start, goal, (0.0, 0.0, lx, ly), walls,
                    f'doorway {w:.2f} m wide in a {t:.2f} m wall, room {lx} x {ly} m')
 
 
 def _zigzag(rng: np.random.Generator, r: FamilyRanges) -> Layout:
-    w = _draw(rng, *r.corridor_width)
+    w = draw(rng, *r.corridor_width)
     turns = int(rng.integers(r.zigzag_turns[0], r.zigzag_turns[1] + 1))
     side = 1.0 if rng.random() < 0.5 else -1.0
     pts = [(0.0, 0.0)]
     for k in range(turns + 1):
         x, y = pts[-1]
-        leg = _draw(rng, *r.zigzag_leg)
+        leg = draw(rng, *r.zigzag_leg)
         if k % 2 == 0:
             pts.append((x + leg, y))
         else:
@@ -284,38 +286,38 @@ def _trap_ends(rng: np.random.Generator, r: FamilyRanges, mouth: float, bottom: 
     mouth, goal behind its bottom, both within ``half`` of the axis [m]."""
     inside = rng.random() < r.trap_inside
     if inside:
-        x = _draw(rng, mouth + 0.35, bottom - 0.35)
+        x = draw(rng, mouth + 0.35, bottom - 0.35)
     else:
-        x = _draw(rng, mouth - 1.5, mouth - 0.5)
-    start = (x, _draw(rng, -half, half))
-    goal = (bottom + _draw(rng, 0.6, 1.8), _draw(rng, -half, half))
+        x = draw(rng, mouth - 1.5, mouth - 0.5)
+    start = (x, draw(rng, -half, half))
+    goal = (bottom + draw(rng, 0.6, 1.8), draw(rng, -half, half))
     return start, goal, 'inside' if inside else 'in front'
 
 
 def _trap_bounds(rng: np.random.Generator, start: tuple[float, float],
                  goal: tuple[float, float], mouth: float,
                  half_width: float) -> tuple[float, float, float, float]:
-    side = half_width + _draw(rng, 1.0, 1.8)
-    return (_on_grid(min(start[0], mouth) - _draw(rng, 0.8, 1.5)), -side,
-            _on_grid(goal[0] + 0.6), side)
+    side = half_width + draw(rng, 1.0, 1.8)
+    return (on_grid(min(start[0], mouth) - draw(rng, 0.8, 1.5)), -side,
+            on_grid(goal[0] + 0.6), side)
 
 
 def _u_trap(rng: np.random.Generator, r: FamilyRanges) -> Layout:
-    depth, width = _draw(rng, *r.trap_depth), _draw(rng, *r.trap_width)
-    t = _draw(rng, *r.wall_thickness)
+    depth, width = draw(rng, *r.trap_depth), draw(rng, *r.trap_width)
+    t = draw(rng, *r.wall_thickness)
     hw = width / 2
-    walls = (_box(-t / 2, -hw - t / 2, t / 2, hw + t / 2),
-             _box(-depth, -hw - t / 2, 0.0, -hw + t / 2),
-             _box(-depth, hw - t / 2, 0.0, hw + t / 2))
+    walls = (box(-t / 2, -hw - t / 2, t / 2, hw + t / 2),
+             box(-depth, -hw - t / 2, 0.0, -hw + t / 2),
+             box(-depth, hw - t / 2, 0.0, hw + t / 2))
     start, goal, where = _trap_ends(rng, r, -depth, -t / 2, max(0.0, hw - t / 2 - 0.35))
     return Layout(start, goal, _trap_bounds(rng, start, goal, -depth, hw + t / 2), walls,
                    f'U {depth:.2f} m deep, {width:.2f} m wide, start {where}', blocked=True)
 
 
 def _c_trap(rng: np.random.Generator, r: FamilyRanges) -> Layout:
-    depth, width = _draw(rng, *r.trap_depth), _draw(rng, *r.trap_width)
-    t = _draw(rng, *r.wall_thickness)
-    phi = math.radians(_draw(rng, *r.c_trap_arc))
+    depth, width = draw(rng, *r.trap_depth), draw(rng, *r.trap_width)
+    t = draw(rng, *r.wall_thickness)
+    phi = math.radians(draw(rng, *r.c_trap_arc))
     a, b = depth / (1.0 - math.cos(phi)), width / 2
     theta = np.linspace(-phi, phi, 721)
     xy = np.column_stack((a * np.cos(theta), b * np.sin(theta)))
@@ -337,10 +339,10 @@ def _c_trap(rng: np.random.Generator, r: FamilyRanges) -> Layout:
 
 def _maze(rng: np.random.Generator, r: FamilyRanges) -> Layout:
     rows, cols = (int(v) for v in rng.integers(r.maze_rooms[0], r.maze_rooms[1] + 1, size=2))
-    xs = np.concatenate(([0.0], np.cumsum([_draw(rng, *r.room_size) for _ in range(cols)])))
-    ys = np.concatenate(([0.0], np.cumsum([_draw(rng, *r.room_size) for _ in range(rows)])))
-    xs, ys = [_on_grid(v) for v in xs], [_on_grid(v) for v in ys]
-    t = _draw(rng, *r.wall_thickness)
+    xs = np.concatenate(([0.0], np.cumsum([draw(rng, *r.room_size) for _ in range(cols)])))
+    ys = np.concatenate(([0.0], np.cumsum([draw(rng, *r.room_size) for _ in range(rows)])))
+    xs, ys = [on_grid(v) for v in xs], [on_grid(v) for v in ys]
+    t = draw(rng, *r.wall_thickness)
     edges = [((j, i), (j, i + 1)) for j in range(rows) for i in range(cols - 1)] \
         + [((j, i), (j + 1, i)) for j in range(rows - 1) for i in range(cols)]
     parent = {(j, i): (j, i) for j in range(rows) for i in range(cols)}
@@ -365,14 +367,14 @@ def _maze(rng: np.random.Generator, r: FamilyRanges) -> Layout:
         n_doors += 1
     walls = []
     for k in range(1, cols):
-        walls += [_box(xs[k] - t / 2, a, xs[k] + t / 2, b)
+        walls += [box(xs[k] - t / 2, a, xs[k] + t / 2, b)
                   for a, b in _solid(ys[0], ys[-1], doors.get(('v', k), []))]
     for k in range(1, rows):
-        walls += [_box(a, ys[k] - t / 2, b, ys[k] + t / 2)
+        walls += [box(a, ys[k] - t / 2, b, ys[k] + t / 2)
                   for a, b in _solid(xs[0], xs[-1], doors.get(('h', k), []))]
 
     def spot(lo: float, hi: float) -> float:
-        return _draw(rng, lo + 0.5, hi - 0.5)
+        return draw(rng, lo + 0.5, hi - 0.5)
     start = (spot(xs[0], xs[1]), spot(ys[0], ys[1]))
     goal = (spot(xs[-2], xs[-1]), spot(ys[-2], ys[-1]))
     return Layout(start, goal, (xs[0], ys[0], xs[-1], ys[-1]), tuple(walls),
@@ -380,17 +382,17 @@ def _maze(rng: np.random.Generator, r: FamilyRanges) -> Layout:
 
 
 def _long_walk(rng: np.random.Generator, r: FamilyRanges) -> Layout:
-    walk, ly = _draw(rng, *r.walk_length), _draw(rng, *r.walk_width)
-    t = _draw(rng, *r.wall_thickness)
+    walk, ly = draw(rng, *r.walk_length), draw(rng, *r.walk_width)
+    t = draw(rng, *r.wall_thickness)
     end = r.walk_end
-    total = _on_grid(walk + 2 * end)
+    total = on_grid(walk + 2 * end)
     n = max(2, math.ceil(total / r.walk_room))
-    xs = [_on_grid(k * total / n + rng.uniform(-0.3, 0.3)) for k in range(1, n)]
+    xs = [on_grid(k * total / n + rng.uniform(-0.3, 0.3)) for k in range(1, n)]
     walls = []
     for x in xs:
         for a, b in _solid(0.0, ly, [_door(rng, 0.0, ly, r.door_width, r.door_margin)]):
-            walls.append(_box(x - t / 2, a, x + t / 2, b))
-    start, goal = (end, _draw(rng, 0.5, ly - 0.5)), (total - end, _draw(rng, 0.5, ly - 0.5))
+            walls.append(box(x - t / 2, a, x + t / 2, b))
+    start, goal = (end, draw(rng, 0.5, ly - 0.5)), (total - end, draw(rng, 0.5, ly - 0.5))
     return Layout(start, goal, (0.0, 0.0, total, ly), tuple(walls),
                    f'{n} rooms in a row, {total:.2f} x {ly:.2f} m')
 

@@ -16,12 +16,15 @@ def path_length(path: np.ndarray) -> float:
     return float(np.sum(np.hypot(*np.diff(path[:, :2], axis=0).T)))
 
 
-def min_clearance(world: World, path: np.ndarray) -> float:
+def min_clearance(world: World, path: np.ndarray, times: np.ndarray | None = None) -> float:
     """Smallest gap between the footprint (FOOTPRINT_RADIUS, the burger's) and an
-    obstacle surface [m]."""
+    obstacle surface [m]; with ``times`` (one per path point [s]) the moving obstacles
+    count where each was at that instant."""
     if len(path) == 0:
         return math.nan
-    return min(world.clearance(float(x), float(y)) for x, y in path[:, :2]) - FOOTPRINT_RADIUS
+    when = [None] * len(path) if times is None or not world.moving else times
+    return min(world.clearance(float(x), float(y), None if t is None else float(t))
+               for (x, y), t in zip(path[:, :2], when, strict=True)) - FOOTPRINT_RADIUS
 
 
 def mean_abs_curvature(path: np.ndarray, min_segment: float = 0.01) -> float:

@@ -10,6 +10,11 @@ for scoring. The simulator's odom frame is the world frame.
 
 Like the real burger's base, a command older than ``cmd_timeout`` of simulated
 time is replaced by zero velocity (the watchdog).
+
+Moving obstacles (world ``moving``) are kinematic bodies placed where their
+paths put them at every physics step: the laser sees them and any contact with
+them is a collision, whoever moved; ``hit_while_stopped`` records whether the
+base was commanded to stand still (v = w = 0) at the first contact.
 """
 
 from __future__ import annotations
@@ -94,6 +99,8 @@ class BurgerSim:
         self._build()
         self.time = 0.0
         self.collided = False
+        #: At the first contact: whether the base was commanded to stand still.
+        self.hit_while_stopped = False
         self._cmd = (0.0, 0.0)
         self._cmd_time = -math.inf
         x, y, yaw = world.start
@@ -111,6 +118,8 @@ class BurgerSim:
         self._plane = c.createMultiBody(0, plane)
         c.changeDynamics(self._plane, -1, lateralFriction=1.0)
         self._obstacles = [self._add_obstacle(o) for o in self.world.all_obstacles()]
+        self._movers = [self._add_obstacle(o) for o in self.world.moving_at(0.0)]
+        self._mover_orn = [c.getBasePositionAndOrientation(b)[1] for b in self._movers]
         x, y, yaw = self.world.start
         with resources.as_file(resources.files(__package__) / 'urdf'
                                / 'burger_standin.urdf') as urdf:
@@ -160,10 +169,14 @@ class BurgerSim:
         self._cmd = (v, w)
         self._cmd_time = self.time
 
-    def _apply_wheels(self) -> None:
-        v, w = self._cmd
+    def _wheel_command(self) -> tuple[float, float]:
+        """The (v, w) the base drives: the last command, or zero after cmd_timeout."""
         if self.time - self._cmd_time > self.config.cmd_timeout:
-            v, w = 0.0, 0.0
+            return 0.0, 0.0
+        return self._cmd
+
+    def _apply_wheels(self) -> None:
+        v, w = self._wheel_command()
         left = (v - w * ROBOT.wheel_separation / 2) / ROBOT.wheel_radius
         right = (v + w * ROBOT.wheel_separation / 2) / ROBOT.wheel_radius
         self._client.setJointMotorControlArray(
@@ -175,11 +188,21 @@ class BurgerSim:
         c = self._client
         for _ in range(max(1, int(round(duration / self.config.physics_dt)))):
             self._apply_wheels()
+            if self._movers:
+                self._place_movers(self.time + self.config.physics_dt)
             c.stepSimulation()
             self.time += self.config.physics_dt
             self._integrate_odom()
             if not self.collided and self._touching_obstacle():
                 self.collided = True
+                self.hit_while_stopped = self._wheel_command() == (0.0, 0.0)
+
+    def _place_movers(self, t: float) -> None:
+        """Put each moving obstacle where its path has it at time ``t`` [s]."""
+        reset = self._client.resetBasePositionAndOrientation
+        for body, orn, m in zip(self._movers, self._mover_orn, self.world.moving, strict=True):
+            x, y = m.position(t)
+            reset(body, [float(x), float(y), OBSTACLE_HEIGHT / 2], orn)
 
     def _touching_obstacle(self) -> bool:
         return any(cp[2] != self._plane for cp in self._client.getContactPoints(self.robot))

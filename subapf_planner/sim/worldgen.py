@@ -22,6 +22,11 @@ is BASE_TIME + TIME_FACTOR x geodesic length / MAX_SPEED [s], the geodesic being
 the shortest 8-connected path through the free cells (at most 8 % longer than
 the true shortest path).
 
+The dynamic families (sim/dynamic_families.py) are checked the same way on their
+static obstacles (moving ones are not walls: they pass); in addition no moving
+obstacle may come within START_MARGIN m of the start's footprint in the first
+START_GRACE s, and its paths go through the same symmetry and shift.
+
 Pure numpy and scipy: no ROS, no simulator.
 """
 
@@ -34,12 +39,21 @@ import zlib
 
 import numpy as np
 
+from .dynamic_families import DYNAMIC_BUILDERS, DYNAMIC_FAMILIES, DYNAMIC_RANGES
 from .families import BUILDERS, FAMILIES, RANGES, FamilyRanges, Layout, circle
 from .solvability import geodesic_length
-from .world import World, WorldError, parse_world
+from .world import FOOTPRINT_RADIUS, World, WorldError, parse_world
 
-__all__ = ['FAMILIES', 'RANGES', 'FamilyRanges', 'GeneratedWorld', 'generate',
-           'generate_world', 'sub_seed', 'suite', 'suite_worlds', 'time_limit']
+__all__ = ['ALL_FAMILIES', 'DYNAMIC_FAMILIES', 'FAMILIES', 'RANGES', 'FamilyRanges',
+           'GeneratedWorld', 'generate', 'generate_world', 'sub_seed', 'suite',
+           'suite_worlds', 'time_limit']
+
+#: Every family: the static ones of the dev suite (the default), then the dynamic ones.
+ALL_FAMILIES = FAMILIES + DYNAMIC_FAMILIES
+#: No moving obstacle within this gap of the start's footprint [m] ...
+START_MARGIN = 0.5
+#: ... during the first seconds of the run [s].
+START_GRACE = 3.0
 
 #: Least distance from the start and the goal to any obstacle surface [m].
 ENDPOINT_CLEARANCE = 0.3
@@ -112,10 +126,23 @@ def _document(layout: Layout, rng: np.random.Generator, name: str) -> dict[str, 
     goal = point(*layout.goal)
     heading = math.atan2(goal[1], goal[0]) + rng.uniform(-math.pi / 6, math.pi / 6)
     heading = math.atan2(math.sin(heading), math.cos(heading))
-    return {'name': name, 'description': layout.note, 'start': [0.0, 0.0, _as_written(heading)],
-            'goal': goal, 'goal_tolerance': GOAL_TOLERANCE, 'time_limit': BASE_TIME,
-            'bounds': [_as_written(v) for v in (*corners.min(axis=0), *corners.max(axis=0))],
-            'obstacles': obstacles}
+    doc = {'name': name, 'description': layout.note, 'start': [0.0, 0.0, _as_written(heading)],
+           'goal': goal, 'goal_tolerance': GOAL_TOLERANCE, 'time_limit': BASE_TIME,
+           'bounds': [_as_written(v) for v in (*corners.min(axis=0), *corners.max(axis=0))],
+           'obstacles': obstacles}
+    if layout.moving:
+        doc['moving'] = [{**m, 'path': [[t, *point(x, y)] for t, x, y in m['path']]}
+                         for m in layout.moving]
+    return doc
+
+
+def _start_crowded(world: World) -> bool:
+    """A moving obstacle comes within START_MARGIN of the start's footprint in the
+    first START_GRACE seconds."""
+    x, y = world.start[:2]
+    return any(o.distance(x, y) < FOOTPRINT_RADIUS + START_MARGIN
+               for t in np.arange(0.0, START_GRACE + 1e-9, 0.1)
+               for o in world.moving_at(float(t)))
 
 
 def _line_blocked(world: World, step: float = 0.02) -> bool:
@@ -131,8 +158,9 @@ def _family_key(family: str) -> int:
 
 
 def _check_family(family: str) -> None:
-    if family not in BUILDERS:
-        raise ValueError(f'unknown world family {family!r}; choose from {", ".join(FAMILIES)}')
+    if family not in BUILDERS and family not in DYNAMIC_BUILDERS:
+        raise ValueError(f'unknown world family {family!r}; choose from '
+                         f'{", ".join(ALL_FAMILIES)}')
 
 
 def time_limit(geodesic: float) -> int:
@@ -155,7 +183,8 @@ def generate_world(family: str, seed: int, name: str | None = None,
     for attempt in range(MAX_ATTEMPTS):
         rng = np.random.default_rng(np.random.SeedSequence([int(seed), _family_key(family),
                                                             attempt]))
-        layout = BUILDERS[family](rng, ranges)
+        layout = BUILDERS[family](rng, ranges) if family in BUILDERS \
+            else DYNAMIC_BUILDERS[family](rng, DYNAMIC_RANGES)
         doc = _document(layout, rng, name)
         try:
             world = parse_world(doc, name)
@@ -165,6 +194,8 @@ def generate_world(family: str, seed: int, name: str | None = None,
                 < ENDPOINT_CLEARANCE:
             continue
         if layout.blocked and not _line_blocked(world):
+            continue
+        if world.moving and _start_crowded(world):
             continue
         length = geodesic_length(world)
         if not math.isfinite(length):

@@ -29,6 +29,7 @@ from ..sim.episode import run_episode
 from ..sim.faults import ScanFaults
 from ..sim.simulator import SimConfig
 from ..sim.world import WorldError, load_world, world_files
+from .animation import animate_run
 from .plots import plot_trajectories
 
 #: The default comparison: the package's default, the paper's method and its ablations
@@ -55,7 +56,7 @@ def parse_method(spec: str) -> dict:
 
 def _run_world(job: tuple) -> list[tuple[dict, list]]:
     """All methods on one world (in a worker), and its plot when ``plot_dir`` is set."""
-    path, methods, cfg, sim_cfg, faults, plot_dir = job
+    path, methods, cfg, sim_cfg, faults, plot_dir, animate = job
     world = load_world(path)
     out = []
     for spec in methods:
@@ -64,9 +65,11 @@ def _run_world(job: tuple) -> list[tuple[dict, list]]:
         result = run_episode(world, run_cfg, sim_cfg, faults=faults, label=label)
         out.append((result.metrics(world), result.path[:, :2].round(4).tolist()))
     if plot_dir is not None:
-        plot_trajectories(world, {r['method']: np.asarray(p) for r, p in out},
-                          {r['method']: r['outcome'] for r, _ in out},
-                          Path(plot_dir) / f'{world.name}.png')
+        paths = {r['method']: np.asarray(p) for r, p in out}
+        plot_trajectories(world, paths, {r['method']: r['outcome'] for r, _ in out},
+                          Path(plot_dir) / f'{world.name}.png', cfg.period)
+        if animate:
+            animate_run(world, paths, Path(plot_dir) / f'{world.name}.gif', cfg.period)
     return out
 
 
@@ -93,6 +96,13 @@ def paired(runs: list[dict], methods: list[str]) -> str:
     return '\n'.join(lines) + '\n'
 
 
+def _collisions(runs: list[dict]) -> str:
+    """Collision count, with how many hit a robot standing still."""
+    hits = [r for r in runs if r['outcome'] == 'collision']
+    stopped = sum(bool(r.get('hit_while_stopped')) for r in hits)
+    return f'{len(hits)} ({stopped} stopped)' if stopped else str(len(hits))
+
+
 def summarise(runs: list[dict], methods: list[str]) -> str:
     """Markdown table per method, then an outcome matrix method x world."""
     lines = ['| method | runs | reached | collisions | timeouts | abandoned | median time [s] '
@@ -108,7 +118,7 @@ def summarise(runs: list[dict], methods: list[str]) -> str:
             return f'{statistics.median(r[key] for r in rows):.2f}' if rows else '-'
         lines.append(
             f'| {m} | {len(rs)} | {len(ok)}/{len(rs)} '
-            f'| {sum(r["outcome"] == "collision" for r in rs)} '
+            f'| {_collisions(rs)} '
             f'| {sum(r["outcome"] == "timeout" for r in rs)} '
             f'| {sum(r["outcome"] == "abandoned" for r in rs)} | {med("time_s")} '
             f'| {med("path_length")} | {min(r["min_clearance"] for r in rs):.3f} '
@@ -144,6 +154,8 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
     p.add_argument('--scan-latency', type=float, default=0.0,
                    help='seconds between a scan and its delivery to the planner')
     p.add_argument('--no-plots', action='store_true', help='skip the PNGs')
+    p.add_argument('--animate', action='store_true',
+                   help="also write an animated GIF of each world's runs")
     return p.parse_args(argv)
 
 
@@ -170,7 +182,7 @@ def main(argv: list[str] | None = None) -> int:
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     plot_dir = None if args.no_plots else str(out)
-    jobs = [(f, methods, cfg, sim_cfg, faults, plot_dir) for f in worlds]
+    jobs = [(f, methods, cfg, sim_cfg, faults, plot_dir, args.animate) for f in worlds]
     t0 = time.perf_counter()
     with ProcessPoolExecutor(max_workers=max(1, args.jobs)) as pool:
         per_world = list(tqdm(pool.map(_run_world, jobs), total=len(jobs), unit='world',

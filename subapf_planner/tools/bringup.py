@@ -128,10 +128,11 @@ def main(argv: list[str] | None = None) -> int:
     print(f'subapf-bringup: outcome {result.outcome}, simulated time {result.sim_time:.1f} s, '
           f'path length {path_length(result.path):.2f} m', flush=True)
     if len(result.path):
+        from ..ros.sim_node import TICK
         from .plots import plot_trajectories
         png = plot_trajectories(world, {result.method: result.path},
                                 {result.method: result.outcome},
-                                args.png or f'{world.name}.png')
+                                args.png or f'{world.name}.png', period=TICK)
         print(f'subapf-bringup: trajectory plot {png}')
     if args.record:
         print(f'subapf-bringup: recorded {args.record}')

@@ -1,8 +1,9 @@
 """``subapf-worlds``: write a seeded suite of procedural worlds (format v1 YAML).
 
 ``subapf-worlds --out DIR [--count 210] [--seed 2026] [--families barn,maze,...]``
-writes DIR/<family>_<index>.yaml for each world of ``sim.worldgen.suite`` (the
-families take turns; the same seed writes the same files) and prints, per family,
+(``--families dynamic``: every family with moving obstacles) writes
+DIR/<family>_<index>.yaml for each world of ``sim.worldgen.suite`` (the families
+take turns; the same seed writes the same files) and prints, per family,
 the number of worlds, their mean obstacle count and mean geodesic length.
 """
 
@@ -17,7 +18,7 @@ from typing import Any
 
 import yaml
 
-from ..sim.worldgen import FAMILIES, suite_worlds
+from ..sim.worldgen import ALL_FAMILIES, DYNAMIC_FAMILIES, FAMILIES, suite_worlds
 
 PROG = 'subapf-worlds'
 
@@ -48,6 +49,10 @@ def world_yaml(doc: dict[str, Any]) -> str:
             out[key] = [{kind: _Flow({k: _FlowList(v) if isinstance(v, list) else v
                                       for k, v in spec.items()})
                          for kind, spec in o.items()} for o in value]
+        elif key == 'moving':
+            out[key] = [{k: _FlowList([_FlowList(p) for p in v]) if k == 'path' else
+                         _Flow(v) if isinstance(v, dict) else v for k, v in m.items()}
+                        for m in value]
         else:
             out[key] = _FlowList(value) if isinstance(value, list) else value
     return yaml.dump(out, Dumper=_Dumper, sort_keys=False, width=1000)
@@ -59,7 +64,8 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
     p.add_argument('--count', type=int, default=210, help='number of worlds (default 210)')
     p.add_argument('--seed', type=int, default=2026, help='suite seed (default 2026)')
     p.add_argument('--families', default=','.join(FAMILIES),
-                   help=f'comma-separated, of {",".join(FAMILIES)} (default: all)')
+                   help=f'comma-separated, of {",".join(ALL_FAMILIES)}; "dynamic" for '
+                   f'{",".join(DYNAMIC_FAMILIES)} (default: the static {",".join(FAMILIES)})')
     return p.parse_args(argv)
 
 
@@ -69,10 +75,12 @@ def main(argv: list[str] | None = None) -> int:
     except SystemExit as exc:   # argparse's usage errors (code 2) and --help (0)
         return int(exc.code or 0) if not isinstance(exc.code, str) else 2
     families = tuple(f.strip() for f in args.families.split(',') if f.strip())
-    bad = [f for f in families if f not in FAMILIES]
+    if families == ('dynamic',):
+        families = DYNAMIC_FAMILIES
+    bad = [f for f in families if f not in ALL_FAMILIES]
     if bad or not families:
         print(f'{PROG}: unknown world family {bad or args.families!r}; choose from '
-              f'{",".join(FAMILIES)}', file=sys.stderr)
+              f'{",".join(ALL_FAMILIES)}', file=sys.stderr)
         return 2
     if len(set(families)) != len(families):
         print(f'{PROG}: family listed twice in {args.families!r}', file=sys.stderr)
@@ -98,8 +106,9 @@ def main(argv: list[str] | None = None) -> int:
         sel = [w for w in worlds if w.family == family]
         if not sel:
             continue
-        print(f'{family:10s} {len(sel):4d} worlds, '
+        print(f'{family:15s} {len(sel):4d} worlds, '
               f'{statistics.mean(len(w.doc["obstacles"]) for w in sel):6.1f} obstacles, '
+              f'{statistics.mean(len(w.doc.get("moving", ())) for w in sel):5.1f} moving, '
               f'geodesic {statistics.mean(w.geodesic_length for w in sel):5.1f} m (mean), '
               f'time limit {statistics.mean(w.doc["time_limit"] for w in sel):5.0f} s (mean)')
     print(f'{len(worlds)} worlds written to {out} in {wall:.1f} s (seed {args.seed})')
