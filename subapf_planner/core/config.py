@@ -128,6 +128,26 @@ class PlannerConfig:
     field_period: float = param(1.0, 'Shortest time between two field computations (sooner '
                                 'for a new goal, or when the robot leaves the patch)', 's',
                                 0.0, 60.0)
+    # --- moving obstacles (core/tracking.py, core/evasion.py) ------------------------
+    track_moving: bool = param(True, 'Track moving obstacles from the scans (clusters, '
+                               'constant-velocity Kalman filters): their points stay out of '
+                               'the memory, and the command is checked against where they '
+                               "will be (with the geodesic attraction; the paper's method "
+                               'and DWA do without)')
+    cluster_gap: float = param(0.15, 'Laser points closer than this belong to one cluster',
+                               'm', 0.01, 1.0)
+    max_mover_size: float = param(1.2, 'Clusters longer than this are walls, never tracked',
+                                  'm', 0.1, 10.0)
+    track_gate: float = param(0.6, "A cluster farther than this from a track's prediction "
+                              'is not that track', 'm', 0.05, 5.0)
+    moving_speed: float = param(0.04, 'A track at least this fast moves', 'm/s', 0.0, 5.0)
+    prediction_horizon: float = param(2.0, 'How far ahead moving tracks are predicted and '
+                                      'the command rolled out against them', 's', 0.2, 10.0)
+    moving_clearance: float = param(0.1, 'Gap kept between the footprint and a moving '
+                                    "track's predicted disc", 'm', 0.0, 2.0)
+    reverse_speed: float = param(0.15, 'Speed at which the robot may back away from '
+                                 'something coming at it (0: never reverses; the burger '
+                                 'backs at up to 0.22 m/s)', 'm/s', 0.0, 5.0)
     # --- DWA baseline (Fox, Burgard, Thrun 1997) ---------------------------------------
     dwa_clearance: float = param(BURGER.clearance, 'DWA: arcs passing closer than this to an '
                                  'obstacle point are inadmissible (robot_radius + 0.03 m)',
@@ -163,6 +183,11 @@ class PlannerConfig:
     def discard_distance(self) -> float:
         """Samples closer than this to a laser point are discarded (Algorithm 1) [m]."""
         return self.sample_clearance if self.geodesic else self.danger_distance
+
+    @property
+    def tracks_moving(self) -> bool:
+        """Moving obstacles are tracked: with the memory (geodesic attraction) only."""
+        return self.track_moving and self.geodesic
 
     @property
     def laser_mount(self) -> tuple[float, float, float]:

@@ -31,6 +31,9 @@ from .status import State, Status
 POSE_HISTORY = 100
 #: A scan is placed with the odometry pose nearest its stamp, if within this [s].
 POSE_MATCH = 0.1
+#: The progress checker waits while a moving obstacle is this close [m]: giving way to
+#: someone is not being stuck.
+GIVING_WAY_DISTANCE = 2.0
 
 
 @dataclass(frozen=True)
@@ -60,16 +63,6 @@ class Decision:
     state: State
     reason: str
     result: PlanResult | None = None
-
-    @property
-    def grid(self) -> OccupancyGrid:
-        """The occupancy memory (read it, do not change it)."""
-        return self.planner.memory.grid
-
-    def seed_command(self, command: tuple[float, float]) -> None:
-        """The command the robot was last sent by someone else (a replay that starts
-        mid-run): the next command's acceleration limits start from it."""
-        self.planner.previous = (float(command[0]), float(command[1]))
 
     @property
     def text(self) -> str:
@@ -194,6 +187,8 @@ class DecisionLoop:
             return self._stop(State.REACHED, 'goal within tolerance', result)
         if cmd.status.stops:
             return self._stop(State.STOPPED, cmd.status, result)
+        if _giving_way(result, self.pose):
+            self._progress = None
         if self._no_progress(now):
             return self._stop(State.STUCK, 'no progress, goal abandoned', result)
         return self._decide((cmd.v, cmd.w), State.DRIVING, cmd.status, result)
@@ -204,3 +199,11 @@ class DecisionLoop:
             self._progress = (self.pose[:2].copy(), now)
             return False
         return now - self._progress[1] > self.limits.progress_timeout
+
+
+def _giving_way(result: PlanResult, pose: np.ndarray) -> bool:
+    """A moving track is within GIVING_WAY_DISTANCE of the robot."""
+    t = result.tracks
+    if not np.any(t.moving):
+        return False
+    return bool(np.min(np.hypot(*(t.position[t.moving] - pose[:2]).T)) < GIVING_WAY_DISTANCE)

@@ -13,7 +13,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numpy.typing import ArrayLike
+from numpy.typing import ArrayLike, NDArray
 
 from .config import PlannerConfig
 from .navigation import NavigationField, compute_field
@@ -52,16 +52,37 @@ class NavigationMemory:
         self.field, self._field_key, self._field_time = None, None, -math.inf
         self._scan_stamp = None
 
-    def integrate(self, scan: Scan, scan_pose: ArrayLike,
-                  goal: ArrayLike | None = None) -> bool:
+    def integrate(self, scan: Scan, scan_pose: ArrayLike, goal: ArrayLike | None = None,
+                  transient: NDArray[np.bool_] | None = None) -> bool:
         """Add a scan taken with base_footprint at ``scan_pose`` unless the scan with its
-        stamp was added already (a NaN stamp is always new)."""
+        stamp was added already (a NaN stamp is always new); ``transient`` marks the beams
+        that returned from something moving (OccupancyGrid.update)."""
         if self._scan_stamp is not None and scan.stamp == self._scan_stamp:
             return False
         self._scan_stamp = scan.stamp
         self.grid.follow(scan_pose, goal)
-        self.grid.update(scan, compose(scan_pose, self.cfg.laser_mount), self.cfg.obstacle_range)
+        self.grid.update(scan, compose(scan_pose, self.cfg.laser_mount), self.cfg.obstacle_range,
+                         transient)
         return True
+
+    def clear(self, points: ArrayLike) -> None:
+        """Cells under ``points`` (n, 2) [m] that are occupied become unknown: something
+        that moved stood there (core/tracking.py's trail)."""
+        cells = self.grid.cell_of(np.asarray(points, float).reshape(-1, 2))
+        cells = cells[self.grid.inside(cells)]
+        lo = self.grid.log_odds
+        hit = lo[cells[:, 0], cells[:, 1]] > 0.0
+        if np.any(hit):
+            lo[cells[hit, 0], cells[hit, 1]] = 0.0
+            self.grid.version += 1
+
+    def log_odds_at(self, points: ArrayLike) -> NDArray[np.float32]:
+        """The map's log odds at each point (n, 2) [m] (0, unknown, off the window)."""
+        cells = self.grid.cell_of(np.asarray(points, float).reshape(-1, 2))
+        inside = self.grid.inside(cells)
+        out = np.zeros(len(cells), np.float32)
+        out[inside] = self.grid.log_odds[cells[inside, 0], cells[inside, 1]]
+        return out
 
     def _covers(self, position: np.ndarray) -> bool:
         f = self.field

@@ -132,10 +132,13 @@ class OccupancyGrid:
         self.version += 1
 
     # --- scans ------------------------------------------------------------------------
-    def update(self, scan: Scan, laser_pose: ArrayLike, clear_range: float = math.inf) -> None:
+    def update(self, scan: Scan, laser_pose: ArrayLike, clear_range: float = math.inf,
+               transient: NDArray[np.bool_] | None = None) -> None:
         """Integrate one scan taken with the laser at ``laser_pose`` (x, y, yaw) in odom
         (see the module docstring for the rule). Its geometry is assumed checked
-        (Scan.check: the planner refuses a bad scan before this is called)."""
+        (Scan.check: the planner refuses a bad scan before this is called).
+        ``transient`` (per beam): returns of something moving; their beams clear the
+        cells they cross but their end cells are not marked (core/tracking.py)."""
         r = np.asarray(scan.ranges, float).ravel()
         lx, ly, lyaw = (float(v) for v in laser_pose)
         angles = scan.angles + lyaw
@@ -148,6 +151,7 @@ class OccupancyGrid:
         if not np.any(use):
             return
         a, length, ends_hit = angles[use], lengths[use], hit[use]
+        marked = ends_hit if transient is None else ends_hit & ~transient[use]
         res = self.resolution
         # free samples at (k + 1/2) cells along each beam, stopping half a cell before a
         # return so its own cell is not cleared; built ragged (only the samples a beam has)
@@ -170,8 +174,8 @@ class OccupancyGrid:
         y0 = (ly - self.origin[1]) / res - r0
         c, s = np.cos(a), np.sin(a)
         free = self._flat(x0 + c[beam] * k, y0 + s[beam] * k, box)
-        ends = self._flat(x0 + c[ends_hit] * length[ends_hit] / res,
-                          y0 + s[ends_hit] * length[ends_hit] / res, box)
+        ends = self._flat(x0 + c[marked] * length[marked] / res,
+                          y0 + s[marked] * length[marked] / res, box)
         # each touched cell changes once however many beams touch it; a return wins
         mark = np.zeros((r1 - r0) * (c1 - c0), np.int8)
         mark[free] = 1

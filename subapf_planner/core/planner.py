@@ -6,6 +6,8 @@ per period):
 1. **perceive**: the scan's valid returns -> point obstacles in odom (scan.py,
    with the laser mounting of robot.py); with ``attraction_field: geodesic``
    (the default) the scan also goes into the occupancy memory (memory.py);
+   moving obstacles are tracked (tracking.py) and their points kept out of the
+   memory;
 2. **gate**: the inputs (:func:`input_status`: non-finite pose or goal; a scan
    with a bad geometry) and the goal (:func:`goal_status`: reached, inside an
    obstacle; with the memory, unreachable through it) each stop the robot with
@@ -13,7 +15,9 @@ per period):
 3. **plan** (:func:`local_plan`, pure): the raw next move point of the APF step,
    eq. (23) (apf.py), circular sampling, Algorithm 1 and the Fig. 5 priority
    (sampling.py), the chosen point -> (v, w) (command.py). With the memory the
-   attraction of eq. (21) is replaced by the navigation field (navigation.py).
+   attraction of eq. (21) is replaced by the navigation field (navigation.py);
+   last, the command is checked against where the moving tracks will be, and
+   replaced when it meets one (evasion.py).
 
 ``subharmonic``, ``traditional`` and ``harmonic`` skip the sampling and steer
 to the raw point (the paper's ablations); ``dwa`` replaces the APF step, the
@@ -34,11 +38,13 @@ from .apf import apf_step
 from .command import Command, forward_blocked, shape_command
 from .config import PlannerConfig
 from .dwa import dwa_command
+from .evasion import evade
 from .memory import NavigationMemory
 from .navigation import NavigationField
 from .sampling import SamplingResult, clearance, sample_and_choose
 from .scan import Scan, ScanError, scan_to_points, voxel_downsample
 from .status import Status
+from .tracking import NO_TRACKS, Tracker, Tracks
 
 _EMPTY = np.zeros((0, 2))
 
@@ -57,6 +63,8 @@ class PlanResult:
     field: NavigationField | None = None
     #: Whether this cycle computed a new navigation field (the expensive part).
     new_field: bool = False
+    #: The tracked obstacles of this cycle's scan (core/tracking.py).
+    tracks: Tracks = NO_TRACKS
 
 
 def input_status(pose: ArrayLike, goal: ArrayLike) -> Status | None:
@@ -145,6 +153,14 @@ def local_plan(cfg: PlannerConfig, pose: NDArray, goal: NDArray, seen: dict,
     return PlanResult(cmd, raw, target, sampling, field=field, **seen)
 
 
+def _tracker_settings(cfg: PlannerConfig) -> tuple[float, float, float, float]:
+    return (cfg.cluster_gap, cfg.max_mover_size, cfg.track_gate, cfg.moving_speed)
+
+
+def _tracker(cfg: PlannerConfig) -> Tracker:
+    return Tracker(*_tracker_settings(cfg))
+
+
 def _plan_dwa(cfg: PlannerConfig, pose: NDArray, goal: NDArray,
               previous: tuple[float, float], seen: dict,
               field: NavigationField | None) -> PlanResult:
@@ -167,6 +183,7 @@ class Planner:
         self._cfg = cfg
         self.previous: tuple[float, float] = (0.0, 0.0)
         self.memory = NavigationMemory(cfg)
+        self.tracker = _tracker(cfg)
 
     @property
     def cfg(self) -> PlannerConfig:
@@ -174,6 +191,8 @@ class Planner:
 
     @cfg.setter
     def cfg(self, cfg: PlannerConfig) -> None:
+        if _tracker_settings(cfg) != _tracker_settings(self._cfg):
+            self.tracker = _tracker(cfg)
         self._cfg = cfg
         self.memory.reconfigure(cfg)
 
@@ -182,9 +201,10 @@ class Planner:
         self.previous = (0.0, 0.0)
 
     def forget(self) -> None:
-        """Forget the last command and the map (a restarted simulation)."""
+        """Forget the last command, the map and the tracks (a restarted simulation)."""
         self.reset()
         self.memory.forget()
+        self.tracker.reset()
 
     def step(self, pose: ArrayLike, goal: ArrayLike, scan: Scan,
              scan_pose: ArrayLike | None = None, now: float | None = None) -> PlanResult:
@@ -206,8 +226,11 @@ class Planner:
             points = scan_to_points(scan, scan_pose, cfg.laser_mount, cfg.obstacle_range)
         except ScanError:
             return self._stop(PlanResult(Command(0.0, 0.0, Status.INVALID_SCAN)))
+        tracks, transient = self._track(scan, points, now)
         if cfg.geodesic:
-            self.memory.integrate(scan, scan_pose, goal)
+            if len(tracks.trail):
+                self.memory.clear(tracks.trail)
+            self.memory.integrate(scan, scan_pose, goal, transient)
         seen = _situation(pose, goal, points)
         status = goal_status(cfg, seen['goal_distance'], goal, seen['obstacles'])
         field, new_field = None, False
@@ -217,11 +240,40 @@ class Planner:
             if field is None or not field.reachable(pose[:2]):
                 status = Status.GOAL_UNREACHABLE
         if status is not None:
-            return self._stop(PlanResult(Command(0.0, 0.0, status), field=field,
-                                         new_field=new_field, **seen))
-        result = local_plan(cfg, pose, goal, seen, self.previous, field)
+            result = PlanResult(Command(0.0, 0.0, status), field=field, new_field=new_field,
+                                tracks=tracks, **seen)
+        else:
+            result = local_plan(cfg, pose, goal, seen, self.previous, field)
+            if new_field or tracks is not NO_TRACKS:
+                result = dataclasses.replace(result, new_field=new_field, tracks=tracks)
+        if status is not Status.REACHED and np.any(tracks.moving) and cfg.method != 'dwa':
+            result = self._out_of_the_way(pose, result, points)
+        if result.command.status.stops:
+            return self._stop(result)
         self.previous = (result.command.v, result.command.w)
-        return dataclasses.replace(result, new_field=new_field) if new_field else result
+        return result
+
+    def _track(self, scan: Scan, points: NDArray,
+               now: float | None) -> tuple[Tracks, NDArray[np.bool_] | None]:
+        """The tracks of this scan, and per beam whether it returned from a moving one."""
+        t = scan.stamp if math.isfinite(scan.stamp) else now
+        if not self.cfg.tracks_moving or t is None or not math.isfinite(t):
+            return NO_TRACKS, None
+        tracks = self.tracker.update(points, t, self.memory.log_odds_at(points))
+        transient = np.zeros(np.size(scan.ranges), bool)
+        transient[np.flatnonzero(scan.valid(self.cfg.obstacle_range))] = tracks.held_points
+        return tracks, transient
+
+    def _out_of_the_way(self, pose: NDArray, result: PlanResult,
+                        points: NDArray) -> PlanResult:
+        """The result with its command replaced when that would meet a moving track."""
+        cfg, tracks, cmd = self.cfg, result.tracks, result.command
+        static = points[~tracks.moving_points]
+        alt = evade(pose, (cmd.v, cmd.w), tracks, static, cfg,
+                    forward_blocked(pose, points, cfg))
+        if alt is None:
+            return result
+        return dataclasses.replace(result, command=Command(alt[0], alt[1], Status.EVADING))
 
     def _stop(self, result: PlanResult) -> PlanResult:
         self.reset()

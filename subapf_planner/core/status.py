@@ -15,6 +15,8 @@ class Status(StrEnum):
     DRIVING = 'driving'
     TURNING = 'turning'
     BLOCKED_AHEAD = 'blocked_ahead'
+    #: The planned command would meet a moving obstacle: replaced (core/evasion.py).
+    EVADING = 'evading'
     REACHED = 'reached'
     NO_SAFE_MOVE = 'no_safe_move'
     GOAL_IN_OBSTACLE = 'goal_in_obstacle'

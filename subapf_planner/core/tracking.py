@@ -1,0 +1,253 @@
+"""Moving obstacles tracked from the scans: clusters, association, constant-velocity
+Kalman filters; which points move.
+
+Each scan's obstacle points (odom, in beam order) are cut into clusters where
+two neighbours are ``cluster_gap`` or more apart (laser scan segmentation); a
+cluster longer than ``max_mover_size``, or standing mostly on the memory's
+established obstacles, is a wall and is never tracked. The others are
+associated with the tracks predicted to this scan's time (Hungarian assignment,
+scipy, within ``track_gate``) and update their filter; unmatched clusters start
+tentative tracks, and a track unseen for MAX_MISSES scans is dropped.
+
+The filter (per track, vectorised over all tracks) is the constant-velocity
+model: state (x, y, vx, vy) [m, m/s], white-acceleration process noise of
+density ACCEL_NOISE [m^2/s^3], the cluster's centroid measured with
+MEASUREMENT_SIGMA [m]. A hand-written filter of 4 states costs a few array
+operations for every track at once; filterpy's per-object KalmanFilter costs a
+Python object per track per step for the same equations.
+
+A track **moves** when it has been seen MIN_HITS times and its estimated speed
+is at least ``moving_speed``. It is **held** out of the occupancy memory while
+it moves, and while its cluster is new and stands mostly on cells the memory
+has seen free (something new where there was nothing: held NEW_OBJECT_SCANS
+scans, then written if it did not move). Held points are still obstacles for
+the local layer; a person walking by leaves no trail of "wall".
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+from numpy.typing import NDArray
+from scipy.optimize import linear_sum_assignment
+
+#: Process noise density of the constant-velocity model [m^2/s^3].
+ACCEL_NOISE = 0.5
+#: Standard deviation of a centroid measurement [m].
+MEASUREMENT_SIGMA = 0.05
+#: Initial standard deviation of a new track's velocity [m/s].
+INITIAL_SPEED_SIGMA = 0.5
+#: Scans a track may go unseen before it is dropped.
+MAX_MISSES = 3
+#: Scans before a track's speed says whether it moves.
+MIN_HITS = 3
+#: A new object in seen-free space is held out of the memory this many scans.
+NEW_OBJECT_SCANS = 15
+#: A track moves only once it is this far from where it was first seen [m]: the centroid
+#: of a static object's visible side wanders less as the robot drives past it.
+MOVE_DISTANCE = 0.3
+#: Clusters considered per scan at most (the largest first; a bound on the cycle).
+MAX_CLUSTERS = 40
+#: Scans whose held points are cleared from the memory (a mover found late: up to
+#: MOVE_DISTANCE at 0.15 m/s).
+TRAIL_SCANS = 12
+#: Log odds below which a cell counts as seen free (two misses).
+FREE_LOG_ODDS = -0.5
+#: Fraction of a cluster's points on seen-free cells that makes it new.
+NEW_FRACTION = 0.5
+#: Log odds from which a cell is an established obstacle (three hits or more) ...
+WALL_LOG_ODDS = 2.0
+#: ... and the fraction of a cluster's points on such cells that makes it part of the
+#: map: a piece of wall whose visible part changes as the robot drives, not a mover.
+WALL_FRACTION = 0.5
+
+
+@dataclass(frozen=True)
+class Tracks:
+    """The tracks after a scan: position (n, 2) [m] and velocity (n, 2) [m/s] in odom,
+    radius (n,) [m] (half the cluster's extent), whether each moves (n,; by its speed),
+    whether it is held out of the memory (n,; it moves, or it is new in seen-free
+    space), and per scan point the index of its track or -1."""
+
+    position: NDArray[np.float64]
+    velocity: NDArray[np.float64]
+    radius: NDArray[np.float64]
+    moving: NDArray[np.bool_]
+    held: NDArray[np.bool_]
+    point_track: NDArray[np.int64]
+    #: Where the held tracks' points were in the scans before this one (k, 2) [m]: cells
+    #: the memory may have taken for walls before the track was known to move.
+    trail: NDArray[np.float64] = field(default_factory=lambda: np.zeros((0, 2)))
+
+    def _of_points(self, flags: NDArray[np.bool_]) -> NDArray[np.bool_]:
+        idx = self.point_track
+        if not flags.size:
+            return np.zeros(idx.shape, bool)
+        return (idx >= 0) & flags[np.maximum(idx, 0)]
+
+    @property
+    def held_points(self) -> NDArray[np.bool_]:
+        """Per scan point: it belongs to a track held out of the memory."""
+        return self._of_points(self.held)
+
+    @property
+    def moving_points(self) -> NDArray[np.bool_]:
+        """Per scan point: it belongs to a moving track."""
+        return self._of_points(self.moving)
+
+    def predicted(self, t: float) -> NDArray[np.float64]:
+        """Positions of the moving tracks ``t`` seconds ahead (k, 2) [m]."""
+        return self.position[self.moving] + t * self.velocity[self.moving]
+
+
+NO_TRACKS = Tracks(np.zeros((0, 2)), np.zeros((0, 2)), np.zeros(0), np.zeros(0, bool),
+                   np.zeros(0, bool), np.zeros(0, np.int64))
+
+
+def clusters(points: NDArray[np.float64], gap: float) -> tuple[NDArray[np.int64], int]:
+    """Label of each point (n,) and the number of clusters of a scan's points in beam
+    order: a new cluster starts where a point is ``gap`` [m] or more from the one
+    before it (the segmentation of a laser scan); the last cluster joins the first when
+    the sweep closes on it."""
+    n = len(points)
+    if n == 0:
+        return np.zeros(0, np.int64), 0
+    step = np.hypot(*np.diff(points, axis=0).T)
+    labels = np.concatenate([[0], np.cumsum(step >= gap)]).astype(np.int64)
+    count = int(labels[-1]) + 1
+    if count > 1 and np.hypot(*(points[0] - points[-1])) < gap:
+        labels[labels == count - 1] = 0
+        count -= 1
+    return labels, count
+
+
+class Tracker:
+    """Tracks of one robot. Not thread-safe."""
+
+    def __init__(self, gap: float, max_size: float, gate: float, moving_speed: float) -> None:
+        self.gap, self.max_size, self.gate, self.moving_speed = gap, max_size, gate, moving_speed
+        self.x = np.zeros((0, 4))
+        self.P = np.zeros((0, 4, 4))
+        self.hits = np.zeros(0, np.int64)
+        self.misses = np.zeros(0, np.int64)
+        self.new_age = np.zeros(0, np.int64)   # scans since first seen as new, or -1
+        self.radius = np.zeros(0)
+        self.ids = np.zeros(0, np.int64)
+        self.first = np.zeros((0, 2))   # where each track was first seen [m]
+        self._next_id = 0
+        #: (track ids, points) of the last TRAIL_SCANS scans
+        self._history: list[tuple[NDArray[np.int64], NDArray[np.float64]]] = []
+        self.time: float | None = None
+        self._last: Tracks | None = None
+
+    def reset(self) -> None:
+        self.__init__(self.gap, self.max_size, self.gate, self.moving_speed)
+
+    def _predict(self, dt: float) -> None:
+        f = np.eye(4)
+        f[0, 2] = f[1, 3] = dt
+        q = ACCEL_NOISE
+        noise = q * np.array([[dt ** 3 / 3, 0, dt ** 2 / 2, 0], [0, dt ** 3 / 3, 0, dt ** 2 / 2],
+                              [dt ** 2 / 2, 0, dt, 0], [0, dt ** 2 / 2, 0, dt]])
+        self.x = self.x @ f.T
+        self.P = f @ self.P @ f.T + noise
+
+    def _correct(self, rows: NDArray[np.int64], z: NDArray[np.float64]) -> None:
+        cov = self.P[rows]
+        s = cov[:, :2, :2] + MEASUREMENT_SIGMA ** 2 * np.eye(2)
+        gain = cov[:, :, :2] @ np.linalg.inv(s)
+        innovation = z - self.x[rows, :2]
+        self.x[rows] += np.einsum('nij,nj->ni', gain, innovation)
+        self.P[rows] = cov - gain @ cov[:, :2, :]
+
+    def update(self, points: NDArray[np.float64], t: float,
+               log_odds_at: NDArray[np.float64]) -> Tracks:
+        """Take a scan's obstacle points (n, 2) at time ``t`` [s] with the memory's log
+        odds at each (n,; 0 off the map), before the scan is written; returns the tracks.
+        A scan at the same time as the last is not taken again (the tracks stand)."""
+        if self.time is not None and t == self.time and self._last is not None:
+            return self._last   # the same scan again (a tick without a new one)
+        dt = 0.0 if self.time is None else t - self.time
+        if not dt >= 0.0:
+            self.reset()   # time went back (a restarted simulation)
+            dt = 0.0
+        self.time = t
+        if dt > 0.0 and len(self.x):
+            self._predict(dt)
+        labels, count = clusters(points, self.gap)
+        cents, sizes, new, mapped = _cluster_features(points, labels, count, log_odds_at)
+        # walls (long, or standing on the map's established obstacles) are not tracked
+        small = np.flatnonzero((sizes <= self.max_size) & (mapped < WALL_FRACTION))
+        small = small[np.argsort(-sizes[small], kind='stable')][:MAX_CLUSTERS]
+        track_of = np.full(count, -1, np.int64)
+        n_tracks = len(self.x)
+        if n_tracks and small.size:
+            cost = np.hypot(*(self.x[:, None, :2] - cents[None, small]).transpose(2, 0, 1))
+            rows, cols = linear_sum_assignment(np.where(cost <= self.gate, cost, 1e6))
+            ok = cost[rows, cols] <= self.gate
+            rows, cols = rows[ok], cols[ok]
+            self._correct(rows, cents[small[cols]])
+            track_of[small[cols]] = rows
+        seen = np.zeros(n_tracks, bool)
+        seen[track_of[track_of >= 0]] = True
+        self.hits[seen] += 1
+        self.misses[seen] = 0
+        self.misses[~seen] += 1
+        self.new_age[seen & (self.new_age >= 0)] += 1
+        fresh = [k for k in small if track_of[k] < 0]
+        if fresh:
+            track_of[fresh] = n_tracks + np.arange(len(fresh))
+            self.x = np.vstack([self.x, np.column_stack((cents[fresh], np.zeros((len(fresh),
+                                                                                  2))))])
+            p0 = np.diag([MEASUREMENT_SIGMA ** 2] * 2 + [INITIAL_SPEED_SIGMA ** 2] * 2)
+            self.P = np.concatenate([self.P, np.repeat(p0[None], len(fresh), axis=0)])
+            self.hits = np.concatenate([self.hits, np.ones(len(fresh), np.int64)])
+            self.misses = np.concatenate([self.misses, np.zeros(len(fresh), np.int64)])
+            self.new_age = np.concatenate([self.new_age, np.where(
+                new[fresh] >= NEW_FRACTION, 0, -1).astype(np.int64)])
+            self.radius = np.concatenate([self.radius, np.zeros(len(fresh))])
+            self.ids = np.concatenate([self.ids, self._next_id + np.arange(len(fresh))])
+            self.first = np.vstack([self.first, cents[fresh]])
+            self._next_id += len(fresh)
+        keep = self.misses <= MAX_MISSES
+        remap = np.cumsum(keep) - 1
+        self.x, self.P = self.x[keep], self.P[keep]
+        self.hits, self.misses, self.new_age = self.hits[keep], self.misses[keep], \
+            self.new_age[keep]
+        self.radius, self.ids, self.first = self.radius[keep], self.ids[keep], self.first[keep]
+        if remap.size:
+            track_of = np.where(track_of >= 0, remap[np.maximum(track_of, 0)], -1)
+        visible = track_of >= 0
+        self.radius[track_of[visible]] = 0.5 * sizes[visible]
+        speed = np.hypot(self.x[:, 2], self.x[:, 3])
+        went = np.hypot(*(self.x[:, :2] - self.first).T)
+        moving = (self.hits >= MIN_HITS) & (speed >= self.moving_speed) \
+            & (went >= MOVE_DISTANCE)
+        held = moving | ((self.new_age >= 0) & (self.new_age < NEW_OBJECT_SCANS))
+        point_track = track_of[labels] if count else np.zeros(0, np.int64)
+        trail = [pts[np.isin(ids, self.ids[held])] for ids, pts in self._history] \
+            if np.any(held) else []
+        self._history = (self._history + [(np.where(point_track >= 0, self.ids[
+            np.maximum(point_track, 0)] if len(self.ids) else -1, -1), points)])[-TRAIL_SCANS:]
+        self._last = Tracks(self.x[:, :2].copy(), self.x[:, 2:].copy(), self.radius.copy(),
+                            moving, held, point_track,
+                            np.vstack(trail) if trail else np.zeros((0, 2)))
+        return self._last
+
+
+def _cluster_features(points: NDArray[np.float64], labels: NDArray[np.int64], count: int,
+                      log_odds_at: NDArray[np.float64]) -> tuple[NDArray, ...]:
+    """Per cluster: centroid (k, 2), extent (bounding-box diagonal, k) [m], fraction of
+    its points on seen-free cells and on established obstacles (k,)."""
+    n = np.bincount(labels, minlength=count).astype(float)
+    cents = np.column_stack([np.bincount(labels, points[:, i], count) for i in (0, 1)]) \
+        / n[:, None]
+    lo = np.full((count, 2), np.inf)
+    hi = np.full((count, 2), -np.inf)
+    np.minimum.at(lo, labels, points)
+    np.maximum.at(hi, labels, points)
+    sizes = np.hypot(*(hi - lo).T)
+    new = np.bincount(labels, log_odds_at < FREE_LOG_ODDS, count) / n
+    mapped = np.bincount(labels, log_odds_at >= WALL_LOG_ODDS, count) / n
+    return cents, sizes, new, mapped
