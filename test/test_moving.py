@@ -153,3 +153,23 @@ def test_moving_plot_and_animation(tmp_path):
     from PIL import Image
     with Image.open(gif) as im:
         assert im.n_frames == len(np.arange(0.0, 29 * 0.2 + 1e-9, 0.5))
+
+
+def dev_world(family: str, index: int):
+    """World ``index`` of ``family`` in the dynamic dev suite (README: seed 2026)."""
+    from subapf_planner.sim.worldgen import generate, sub_seed
+    name = f'{family}_{index:03d}'
+    return parse_world(generate(family, sub_seed(2026, family, index), name), name)
+
+
+@pytest.mark.parametrize('family, index', [('crossing', 0), ('crossing', 3), ('head_on', 0)])
+def test_default_gets_past_walkers_that_hit_the_planner_without_tracking(family, index):
+    """Someone crossing the robot's way, and someone walking at it down a corridor: the
+    default reaches the goal without touching anyone; the same planner without tracking
+    (the previous default) is hit in both crossings."""
+    w = dev_world(family, index)
+    r = run_episode(w, PlannerConfig(), SimConfig(seed=0))
+    assert r.outcome == 'reached' and r.metrics(w)['min_clearance'] > 0.0, r.statuses
+    if family == 'crossing':
+        blind = run_episode(w, PlannerConfig(track_moving=False), SimConfig(seed=0))
+        assert blind.outcome == 'collision'

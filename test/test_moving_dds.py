@@ -22,24 +22,50 @@ WORLD = {
 }
 
 
+def run_and_replay(tmp_path, env, world_file, bag):
+    """bringup of the world recorded to ``bag``, then subapf-replay of the bag:
+    (bringup result, commands compared, commands within 1e-9)."""
+    r = subprocess.run(
+        [sys.executable, '-m', 'subapf_planner.tools.bringup', '--world', str(world_file),
+         '--rate', '1', '--domain-id', env['ROS_DOMAIN_ID'], '--png',
+         str(tmp_path / 'walkers.png'), '--record', str(bag)],
+        env=env, capture_output=True, text=True, timeout=300, cwd=tmp_path)
+    assert 'outcome ' in r.stdout, r.stdout + r.stderr
+    rep = subprocess.run([sys.executable, '-m', 'subapf_planner.tools.replay', str(bag),
+                          '--tolerance', '1e-9'], capture_output=True, text=True,
+                         timeout=120, env=env)
+    total = int(rep.stdout.split('commands compared: ')[1].split()[0])
+    within = int(rep.stdout.split('within tolerance: ')[1].split()[0])
+    return r, total, within
+
+
 def test_moving_world_through_the_nodes_records_and_replays(tmp_path, bringup_env):
     from rosbags.highlevel import AnyReader
     world_file = tmp_path / 'walkers.yaml'
     world_file.write_text(yaml.safe_dump(WORLD))
     world = parse_world(WORLD)
     bag = tmp_path / 'walkers.mcap'
-    r = subprocess.run(
-        [sys.executable, '-m', 'subapf_planner.tools.bringup', '--world', str(world_file),
-         '--rate', '1', '--domain-id', bringup_env['ROS_DOMAIN_ID'], '--png',
-         str(tmp_path / 'walkers.png'), '--record', str(bag)],
-        env=bringup_env, capture_output=True, text=True, timeout=300, cwd=tmp_path)
-    assert 'outcome ' in r.stdout, r.stdout + r.stderr
-    markers = []
+    # The run, walkers and all, replays through the same decision loop to the last bit,
+    # but for the zero the planner sends when bringup stops it (no tick answers that).
+    # A replay is exact when each scan reached the node before the clock tick that it
+    # precedes; DDS does not order topics, so on a loaded machine one of them may come
+    # late: one more run is allowed for that (a broken replay fails both).
+    r, total, within = run_and_replay(tmp_path, bringup_env, world_file, bag)
+    if within < total - 1:
+        r, total, within = run_and_replay(tmp_path, bringup_env, world_file, bag)
+    assert total >= 20 and within >= total - 1, (total, within)
+    markers, tracked = [], 0
     with AnyReader([bag]) as reader:
         conns = [c for c in reader.connections if c.topic == '/moving_obstacles']
         assert conns and conns[0].msgtype == 'visualization_msgs/msg/MarkerArray'
         for conn, _t, raw in reader.messages(connections=conns):
             markers.append(reader.deserialize(raw, conn.msgtype))
+        planner = [c for c in reader.connections if c.topic == '/subapf_planner/markers']
+        for conn, _t, raw in reader.messages(connections=planner):
+            for m in reader.deserialize(raw, conn.msgtype).markers:
+                tracked += m.ns == 'tracks' and len(m.points) > 0
+    # the planner tracked the walker (~/markers: tracks, velocity, prediction)
+    assert tracked >= 3
     assert len(markers) >= 10
     for msg in markers[::5]:
         t = msg.markers[0].header.stamp.sec + 1e-9 * msg.markers[0].header.stamp.nanosec
@@ -50,11 +76,3 @@ def test_moving_world_through_the_nodes_records_and_replays(tmp_path, bringup_en
                   for dt in (-1e-6, 1e-6))
         assert err < 1e-5, (t, got)
     assert (tmp_path / 'walkers.png').stat().st_size > 10_000
-    # the run, walkers and all, replays through the same decision loop to the last bit,
-    # but for the zero the planner sends when bringup stops it (no tick answers that)
-    rep = subprocess.run([sys.executable, '-m', 'subapf_planner.tools.replay', str(bag),
-                          '--tolerance', '1e-9'], capture_output=True, text=True,
-                         timeout=120, env=bringup_env)
-    total = int(rep.stdout.split('commands compared: ')[1].split()[0])
-    within = int(rep.stdout.split('within tolerance: ')[1].split()[0])
-    assert total >= 20 and within >= total - 1, rep.stdout

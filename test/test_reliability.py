@@ -277,3 +277,19 @@ def test_tf_frames_follow_rep105():
     # base_scan 0.172 m above base_link, base_link 0.010 m above base_footprint
     assert LASER_IN_BASE_LINK == pytest.approx((-0.032, 0.0, 0.172))
     assert BASE_LINK_HEIGHT == 0.010
+
+
+def test_seed_command_sets_where_the_acceleration_limits_start():
+    """A replay that starts mid-run seeds the command the robot was last sent: the first
+    planned forward speed is within one period's acceleration of it, not of zero."""
+    def first_v(seed):
+        ctl = DecisionLoop(CFG)
+        ctl.set_goal(np.array([3.0, 0.0]))
+        ctl.update_odom(0.0, np.array([0.0, 0.0, 0.0]), 0.0)
+        ctl.update_scan(Scan(np.full(360, np.inf), 0.0, math.pi / 180, 0.12, 3.5, 0.0), 0.0)
+        if seed is not None:
+            ctl.seed_command(seed)
+        return ctl.tick(0.0).command[0]
+    step = CFG.max_linear_acceleration * CFG.period
+    assert first_v(None) == pytest.approx(step)
+    assert first_v((0.2, 0.0)) == pytest.approx(min(0.2 + step, CFG.max_linear_velocity))

@@ -78,12 +78,13 @@ def _static_clear(pose: NDArray, path: NDArray, static: NDArray, radius: float) 
 
 
 def evade(pose: NDArray[np.float64], planned: tuple[float, float], tracks: Tracks,
-          static: NDArray[np.float64], cfg: PlannerConfig,
-          blocked_ahead: bool) -> tuple[float, float] | None:
+          static: NDArray[np.float64], cfg: PlannerConfig, blocked_ahead: bool,
+          committed: tuple[float, float] | None = None) -> tuple[float, float] | None:
     """A replacement for the ``planned`` (v, w) when its rollout meets a moving track
     (see the module docstring), or None to keep it. ``static``: the laser points that
     are not moving tracks' (m, 2); ``blocked_ahead``: the safety corridor holds a point
-    (forward candidates are then inadmissible)."""
+    (forward candidates are then inadmissible); ``committed``: the escape of the last
+    cycle, kept while it still keeps the clearance (no dithering between escapes)."""
     horizon = cfg.prediction_horizon
     v0, w0 = planned
     if moving_gap(rollout(pose, v0, w0, horizon), tracks, cfg.robot_radius) \
@@ -93,18 +94,19 @@ def evade(pose: NDArray[np.float64], planned: tuple[float, float], tracks: Track
     if cfg.reverse_speed > 0.0:
         speeds.append(-cfg.reverse_speed)
     best, best_key = None, None
-    for v in speeds:
+    candidates = [(v, f * cfg.max_angular_velocity) for v in speeds for f in TURN_FRACTIONS]
+    for v, w in candidates:
         if v > 0.0 and blocked_ahead:
             continue
-        for f in TURN_FRACTIONS:
-            w = f * cfg.max_angular_velocity
-            path = rollout(pose, v, w, horizon)
-            if v != 0.0 and not _static_clear(pose, path, static, cfg.robot_radius):
-                continue
-            gap = moving_gap(path, tracks, cfg.robot_radius)
-            safe = gap >= cfg.moving_clearance
-            # safe ones: closest to the plan; otherwise: the largest gap
-            key = (0, abs(v - v0) + 0.1 * abs(w - w0)) if safe else (1, -gap)
-            if best_key is None or key < best_key:
-                best, best_key = (v, w), key
+        path = rollout(pose, v, w, horizon)
+        if v != 0.0 and not _static_clear(pose, path, static, cfg.robot_radius):
+            continue
+        gap = moving_gap(path, tracks, cfg.robot_radius)
+        # safe ones: the committed escape, else the closest to the plan; otherwise the
+        # largest gap
+        kept = committed is not None and (v, w) == committed
+        key = (0, -1.0 if kept else abs(v - v0) + 0.1 * abs(w - w0)) \
+            if gap >= cfg.moving_clearance else (1, -gap)
+        if best_key is None or key < best_key:
+            best, best_key = (v, w), key
     return best

@@ -184,6 +184,7 @@ class Planner:
         self.previous: tuple[float, float] = (0.0, 0.0)
         self.memory = NavigationMemory(cfg)
         self.tracker = _tracker(cfg)
+        self._escape: tuple[float, float] | None = None   # last cycle's escape command
 
     @property
     def cfg(self) -> PlannerConfig:
@@ -270,7 +271,8 @@ class Planner:
         cfg, tracks, cmd = self.cfg, result.tracks, result.command
         static = points[~tracks.moving_points]
         alt = evade(pose, (cmd.v, cmd.w), tracks, static, cfg,
-                    forward_blocked(pose, points, cfg))
+                    forward_blocked(pose, points, cfg), self._escape)
+        self._escape = alt
         if alt is None:
             return result
         return dataclasses.replace(result, command=Command(alt[0], alt[1], Status.EVADING))

@@ -16,12 +16,14 @@ MEASUREMENT_SIGMA [m]. A hand-written filter of 4 states costs a few array
 operations for every track at once; filterpy's per-object KalmanFilter costs a
 Python object per track per step for the same equations.
 
-A track **moves** when it has been seen MIN_HITS times and its estimated speed
-is at least ``moving_speed``. It is **held** out of the occupancy memory while
-it moves, and while its cluster is new and stands mostly on cells the memory
-has seen free (something new where there was nothing: held NEW_OBJECT_SCANS
-scans, then written if it did not move). Held points are still obstacles for
-the local layer; a person walking by leaves no trail of "wall".
+A track **moves** when it has been seen MIN_HITS times, its estimated speed is
+at least ``moving_speed``, and it has been MOVE_DISTANCE from where it was
+first seen at some time (someone walking to and fro stays a mover). It is
+**held** out of the occupancy memory while it moves, and while its cluster is new
+and stands mostly on cells the memory has seen free (something new where there
+was nothing: held NEW_OBJECT_SCANS scans, then written if it did not move).
+Held points are still obstacles for the local layer; a person walking by leaves
+no trail of "wall".
 """
 
 from __future__ import annotations
@@ -66,8 +68,8 @@ WALL_FRACTION = 0.5
 @dataclass(frozen=True)
 class Tracks:
     """The tracks after a scan: position (n, 2) [m] and velocity (n, 2) [m/s] in odom,
-    radius (n,) [m] (half the cluster's extent), whether each moves (n,; by its speed),
-    whether it is held out of the memory (n,; it moves, or it is new in seen-free
+    radius (n,) [m] (half its cluster's extent), whether each moves (n,; by its
+    speed), whether it is held out of the memory (n,; it moves, or it is new in seen-free
     space), and per scan point the index of its track or -1."""
 
     position: NDArray[np.float64]
@@ -135,6 +137,7 @@ class Tracker:
         self.radius = np.zeros(0)
         self.ids = np.zeros(0, np.int64)
         self.first = np.zeros((0, 2))   # where each track was first seen [m]
+        self.went = np.zeros(0)          # the farthest it has been from there [m]
         self._next_id = 0
         #: (track ids, points) of the last TRAIL_SCANS scans
         self._history: list[tuple[NDArray[np.int64], NDArray[np.float64]]] = []
@@ -209,6 +212,7 @@ class Tracker:
             self.radius = np.concatenate([self.radius, np.zeros(len(fresh))])
             self.ids = np.concatenate([self.ids, self._next_id + np.arange(len(fresh))])
             self.first = np.vstack([self.first, cents[fresh]])
+            self.went = np.concatenate([self.went, np.zeros(len(fresh))])
             self._next_id += len(fresh)
         keep = self.misses <= MAX_MISSES
         remap = np.cumsum(keep) - 1
@@ -216,14 +220,15 @@ class Tracker:
         self.hits, self.misses, self.new_age = self.hits[keep], self.misses[keep], \
             self.new_age[keep]
         self.radius, self.ids, self.first = self.radius[keep], self.ids[keep], self.first[keep]
+        self.went = self.went[keep]
         if remap.size:
             track_of = np.where(track_of >= 0, remap[np.maximum(track_of, 0)], -1)
         visible = track_of >= 0
         self.radius[track_of[visible]] = 0.5 * sizes[visible]
         speed = np.hypot(self.x[:, 2], self.x[:, 3])
-        went = np.hypot(*(self.x[:, :2] - self.first).T)
+        self.went = np.maximum(self.went, np.hypot(*(self.x[:, :2] - self.first).T))
         moving = (self.hits >= MIN_HITS) & (speed >= self.moving_speed) \
-            & (went >= MOVE_DISTANCE)
+            & (self.went >= MOVE_DISTANCE)
         held = moving | ((self.new_age >= 0) & (self.new_age < NEW_OBJECT_SCANS))
         point_track = track_of[labels] if count else np.zeros(0, np.int64)
         trail = [pts[np.isin(ids, self.ids[held])] for ids, pts in self._history] \

@@ -62,6 +62,7 @@ def markers_from_result(result: PlanResult, frame: str, stamp: Time,
                 t = float((s - lo) / (hi - lo)) if hi > lo else 0.0
                 samples.colors.append(ColorRGBA(r=t, g=1.0 - t, b=0.2, a=1.0))
     out.markers.append(samples)
+    out.markers.extend(track_markers(result, frame, stamp))
     ring = _marker('danger_circle', 0, Marker.LINE_STRIP, frame, stamp, 0.01,
                    (1.0, 0.0, 0.0, 0.5))
     a = np.linspace(0.0, 2.0 * math.pi, 37)
@@ -69,6 +70,29 @@ def markers_from_result(result: PlanResult, frame: str, stamp: Time,
                                            position[1] + danger_distance * np.sin(a))))
     out.markers.append(ring)
     return out
+
+
+#: Seconds of prediction drawn for each moving track.
+PREDICTION_SHOWN = 2.0
+
+
+def track_markers(result: PlanResult, frame: str, stamp: Time) -> list[Marker]:
+    """The moving tracks of a cycle: their positions (orange points), velocity arrows
+    (one LINE_LIST: position -> position + velocity * 1 s) and predicted paths
+    (position -> position + velocity * PREDICTION_SHOWN, thin). Three markers always
+    (empty when nothing moves), so a viewer's old tracks are replaced."""
+    t = result.tracks
+    moving = t.moving
+    pos, vel = t.position[moving], t.velocity[moving]
+    here = _marker('tracks', 0, Marker.POINTS, frame, stamp, 0.08, (1.0, 0.5, 0.0, 1.0))
+    here.points = _points(pos)
+    arrows = _marker('track_velocity', 0, Marker.LINE_LIST, frame, stamp, 0.02,
+                     (1.0, 0.3, 0.0, 1.0))
+    arrows.points = _points(np.column_stack((pos, pos + vel)).reshape(-1, 2))
+    paths = _marker('track_prediction', 0, Marker.LINE_LIST, frame, stamp, 0.01,
+                    (1.0, 0.7, 0.2, 0.6))
+    paths.points = _points(np.column_stack((pos, pos + PREDICTION_SHOWN * vel)).reshape(-1, 2))
+    return [here, arrows, paths]
 
 
 def moving_obstacle_markers(obstacles: tuple[Circle | Box, ...], frame: str,

@@ -103,6 +103,36 @@ def _collisions(runs: list[dict]) -> str:
     return f'{len(hits)} ({stopped} stopped)' if stopped else str(len(hits))
 
 
+def family_of(world: str) -> str:
+    """A generated world's family: its name without the index (``arena_007`` -> arena)."""
+    head, _, tail = world.rpartition('_')
+    return head if head and tail.isdigit() else world
+
+
+def by_family(runs: list[dict], methods: list[str]) -> str:
+    """Per family and method: reached, collisions (hit while stopped), timeouts,
+    abandoned, median time of the reached runs and least clearance; '' for a single
+    family."""
+    families = sorted({family_of(r['world']) for r in runs})
+    if len(families) < 2:
+        return ''
+    lines = ['| family | method | reached | collisions | timeouts | abandoned '
+             '| median time [s] | min clearance [m] |', '|' + '---|' * 8]
+    for fam in families:
+        for m in methods:
+            rs = [r for r in runs if r['method'] == m and family_of(r['world']) == fam]
+            if not rs:
+                continue
+            ok = [r['time_s'] for r in rs if r['outcome'] == 'reached']
+            lines.append(
+                f'| {fam} | {m} | {len(ok)}/{len(rs)} | {_collisions(rs)} '
+                f'| {sum(r["outcome"] == "timeout" for r in rs)} '
+                f'| {sum(r["outcome"] == "abandoned" for r in rs)} '
+                f'| {statistics.median(ok) if ok else "-"} '
+                f'| {min(r["min_clearance"] for r in rs):.3f} |')
+    return '\n'.join(lines) + '\n'
+
+
 def summarise(runs: list[dict], methods: list[str]) -> str:
     """Markdown table per method, then an outcome matrix method x world."""
     lines = ['| method | runs | reached | collisions | timeouts | abandoned | median time [s] '
@@ -195,7 +225,8 @@ def main(argv: list[str] | None = None) -> int:
            'scan_latency': args.scan_latency, 'wall_time_s': round(wall, 2),
            'params': dataclasses.asdict(cfg)}
     (out / 'results.json').write_text(json.dumps(doc, indent=1))
-    (out / 'summary.md').write_text(summarise(runs, labels) + '\n' + paired(runs, labels)
+    (out / 'summary.md').write_text(summarise(runs, labels) + '\n' + by_family(runs, labels)
+                                    + '\n' + paired(runs, labels)
                                     + f'\n{len(runs)} runs in {wall:.1f} s wall time.\n')
     print((out / 'summary.md').read_text())
     return 0
