@@ -74,3 +74,10 @@ def test_voxel_downsample_bounds_wall_density():
     voxel_downsample(x, 0.05)
     np.testing.assert_array_equal(x, dense)
     np.testing.assert_array_equal(voxel_downsample(dense, 0.0), dense)
+
+
+def test_geometry_warning_survives_a_denormal_increment():
+    """A header whose span over its increment overflows (a denormal increment, found by
+    the node fuzz) is reported, not a crash."""
+    from subapf_planner.core.scan import geometry_warning
+    assert 'too small' in geometry_warning(2, 1.0, 0.0, 2.2e-309)

@@ -102,7 +102,10 @@ def geometry_warning(n: int, angle_min: float, angle_max: float,
         return f'{n} beams of {angle_increment:.5f} rad cover more than a full turn'
     if not (math.isfinite(angle_min) and math.isfinite(angle_max)):
         return None
-    expected = int(round((angle_max - angle_min) / angle_increment)) + 1
+    span = (angle_max - angle_min) / angle_increment
+    if not math.isfinite(span):
+        return f"angle_increment {angle_increment:g} rad is too small for the header's span"
+    expected = int(round(span)) + 1
     if abs(expected - n) > 1:
         return f'{n} ranges, but angle_min/angle_max/angle_increment describe {expected}'
     return None

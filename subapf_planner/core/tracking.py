@@ -3,8 +3,9 @@ Kalman filters; which points move.
 
 Each scan's obstacle points (odom, in beam order) are cut into clusters where
 two neighbours are ``cluster_gap`` or more apart (laser scan segmentation); a
-cluster longer than ``max_mover_size``, or standing mostly on the memory's
-established obstacles, is a wall and is never tracked. The others are
+cluster longer than ``max_mover_size``, straight (a piece of wall seen at a
+grazing angle), or standing mostly on the memory's established obstacles, is a
+wall and is never tracked. The others are
 associated with the tracks predicted to this scan's time (Hungarian assignment,
 scipy, within ``track_gate``) and update their filter; unmatched clusters start
 tentative tracks, and a track unseen for MAX_MISSES scans is dropped.
@@ -49,6 +50,15 @@ NEW_OBJECT_SCANS = 15
 #: A track moves only once it is this far from where it was first seen [m]: the centroid
 #: of a static object's visible side wanders less as the robot drives past it.
 MOVE_DISTANCE = 0.3
+#: A cluster whose points lie this close to a line [m] (the smaller principal standard
+#: deviation), and that is longer than THIN_LENGTH [m], is a piece of wall: a wall seen
+#: at a grazing angle breaks into short straight pieces whose centroids slide along
+#: it as the robot drives, while a person or a post shows a curved side.
+THIN_STD = 0.02
+THIN_LENGTH = 0.25
+#: Fewer laser points than this are no cluster to track (a wall seen edge-on breaks into
+#: single points; a person 3.5 m away still shows eight).
+MIN_POINTS = 3
 #: Clusters considered per scan at most (the largest first; a bound on the cycle).
 MAX_CLUSTERS = 40
 #: Scans whose held points are cleared from the memory (a mover found late: up to
@@ -179,9 +189,9 @@ class Tracker:
         if dt > 0.0 and len(self.x):
             self._predict(dt)
         labels, count = clusters(points, self.gap)
-        cents, sizes, new, mapped = _cluster_features(points, labels, count, log_odds_at)
+        cents, sizes, new, mapped, thin = _cluster_features(points, labels, count, log_odds_at)
         # walls (long, or standing on the map's established obstacles) are not tracked
-        small = np.flatnonzero((sizes <= self.max_size) & (mapped < WALL_FRACTION))
+        small = np.flatnonzero((sizes <= self.max_size) & (mapped < WALL_FRACTION) & ~thin)
         small = small[np.argsort(-sizes[small], kind='stable')][:MAX_CLUSTERS]
         track_of = np.full(count, -1, np.int64)
         n_tracks = len(self.x)
@@ -244,7 +254,8 @@ class Tracker:
 def _cluster_features(points: NDArray[np.float64], labels: NDArray[np.int64], count: int,
                       log_odds_at: NDArray[np.float64]) -> tuple[NDArray, ...]:
     """Per cluster: centroid (k, 2), extent (bounding-box diagonal, k) [m], fraction of
-    its points on seen-free cells and on established obstacles (k,)."""
+    its points on seen-free cells and on established obstacles (k,), and whether it is a
+    straight piece or too few points to track (k,; THIN_STD, THIN_LENGTH, MIN_POINTS)."""
     n = np.bincount(labels, minlength=count).astype(float)
     cents = np.column_stack([np.bincount(labels, points[:, i], count) for i in (0, 1)]) \
         / n[:, None]
@@ -255,4 +266,10 @@ def _cluster_features(points: NDArray[np.float64], labels: NDArray[np.int64], co
     sizes = np.hypot(*(hi - lo).T)
     new = np.bincount(labels, log_odds_at < FREE_LOG_ODDS, count) / n
     mapped = np.bincount(labels, log_odds_at >= WALL_LOG_ODDS, count) / n
-    return cents, sizes, new, mapped
+    d = points - cents[labels]
+    sxx, syy, sxy = (np.bincount(labels, a * b, count) / n
+                     for a, b in ((d[:, 0], d[:, 0]), (d[:, 1], d[:, 1]), (d[:, 0], d[:, 1])))
+    smallest = 0.5 * (sxx + syy) - np.sqrt(0.25 * (sxx - syy) ** 2 + sxy ** 2)
+    thin = ((np.sqrt(np.maximum(smallest, 0.0)) < THIN_STD) & (sizes > THIN_LENGTH)) \
+        | (n < MIN_POINTS)
+    return cents, sizes, new, mapped, thin

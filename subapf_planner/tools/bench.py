@@ -128,7 +128,7 @@ def by_family(runs: list[dict], methods: list[str]) -> str:
                 f'| {fam} | {m} | {len(ok)}/{len(rs)} | {_collisions(rs)} '
                 f'| {sum(r["outcome"] == "timeout" for r in rs)} '
                 f'| {sum(r["outcome"] == "abandoned" for r in rs)} '
-                f'| {statistics.median(ok) if ok else "-"} '
+                f'| {f"{statistics.median(ok):.1f}" if ok else "-"} '
                 f'| {min(r["min_clearance"] for r in rs):.3f} |')
     return '\n'.join(lines) + '\n'
 
