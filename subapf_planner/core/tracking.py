@@ -137,10 +137,17 @@ def clusters(points: NDArray[np.float64], gap: float) -> tuple[NDArray[np.int64]
 class Tracker:
     """Tracks of one robot. Not thread-safe."""
 
+    #: Per-track arrays, one row per track, appended and filtered together.
+    PER_TRACK = ('x', 'P', 'hits', 'misses', 'new_age', 'radius', 'ids', 'first', 'went')
+
     def __init__(self, gap: float, max_size: float, gate: float, moving_speed: float) -> None:
         self.gap, self.max_size, self.gate, self.moving_speed = gap, max_size, gate, moving_speed
-        self.x = np.zeros((0, 4))
-        self.P = np.zeros((0, 4, 4))
+        self.reset()
+
+    def reset(self) -> None:
+        """No tracks, no history, no time."""
+        self.x = np.zeros((0, 4))        # state (x, y, vx, vy) [m, m/s]
+        self.P = np.zeros((0, 4, 4))     # its covariance
         self.hits = np.zeros(0, np.int64)
         self.misses = np.zeros(0, np.int64)
         self.new_age = np.zeros(0, np.int64)   # scans since first seen as new, or -1
@@ -154,8 +161,15 @@ class Tracker:
         self.time: float | None = None
         self._last: Tracks | None = None
 
-    def reset(self) -> None:
-        self.__init__(self.gap, self.max_size, self.gate, self.moving_speed)
+    def _append(self, **rows: NDArray) -> None:
+        """New tracks: the rows of every PER_TRACK array."""
+        for name in self.PER_TRACK:
+            setattr(self, name, np.concatenate([getattr(self, name), rows[name]]))
+
+    def _keep(self, mask: NDArray[np.bool_]) -> None:
+        """Only the tracks of ``mask``, in every PER_TRACK array."""
+        for name in self.PER_TRACK:
+            setattr(self, name, getattr(self, name)[mask])
 
     def _predict(self, dt: float) -> None:
         f = np.eye(4)
@@ -210,27 +224,19 @@ class Tracker:
         self.new_age[seen & (self.new_age >= 0)] += 1
         fresh = [k for k in small if track_of[k] < 0]
         if fresh:
-            track_of[fresh] = n_tracks + np.arange(len(fresh))
-            self.x = np.vstack([self.x, np.column_stack((cents[fresh], np.zeros((len(fresh),
-                                                                                  2))))])
+            m = len(fresh)
+            track_of[fresh] = n_tracks + np.arange(m)
             p0 = np.diag([MEASUREMENT_SIGMA ** 2] * 2 + [INITIAL_SPEED_SIGMA ** 2] * 2)
-            self.P = np.concatenate([self.P, np.repeat(p0[None], len(fresh), axis=0)])
-            self.hits = np.concatenate([self.hits, np.ones(len(fresh), np.int64)])
-            self.misses = np.concatenate([self.misses, np.zeros(len(fresh), np.int64)])
-            self.new_age = np.concatenate([self.new_age, np.where(
-                new[fresh] >= NEW_FRACTION, 0, -1).astype(np.int64)])
-            self.radius = np.concatenate([self.radius, np.zeros(len(fresh))])
-            self.ids = np.concatenate([self.ids, self._next_id + np.arange(len(fresh))])
-            self.first = np.vstack([self.first, cents[fresh]])
-            self.went = np.concatenate([self.went, np.zeros(len(fresh))])
-            self._next_id += len(fresh)
+            self._append(x=np.column_stack((cents[fresh], np.zeros((m, 2)))),
+                         P=np.repeat(p0[None], m, axis=0), hits=np.ones(m, np.int64),
+                         misses=np.zeros(m, np.int64),
+                         new_age=np.where(new[fresh] >= NEW_FRACTION, 0, -1).astype(np.int64),
+                         radius=np.zeros(m), ids=self._next_id + np.arange(m),
+                         first=cents[fresh], went=np.zeros(m))
+            self._next_id += m
         keep = self.misses <= MAX_MISSES
         remap = np.cumsum(keep) - 1
-        self.x, self.P = self.x[keep], self.P[keep]
-        self.hits, self.misses, self.new_age = self.hits[keep], self.misses[keep], \
-            self.new_age[keep]
-        self.radius, self.ids, self.first = self.radius[keep], self.ids[keep], self.first[keep]
-        self.went = self.went[keep]
+        self._keep(keep)
         if remap.size:
             track_of = np.where(track_of >= 0, remap[np.maximum(track_of, 0)], -1)
         visible = track_of >= 0

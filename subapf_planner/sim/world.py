@@ -12,6 +12,7 @@ error names the file, the field and what was wrong.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 import math
 from pathlib import Path
 from typing import Any
@@ -77,6 +78,12 @@ class MovingObstacle:
     loop: bool = False
     offset: float = 0.0
 
+    @cached_property
+    def _keys(self) -> np.ndarray:
+        """The keyframes as one (k, 3) array, made once (positions are asked for at every
+        physics step)."""
+        return np.asarray(self.keyframes, float)
+
     @property
     def period(self) -> float:
         """Time of the last keyframe [s]."""
@@ -91,14 +98,14 @@ class MovingObstacle:
 
     def position(self, t: float | np.ndarray) -> np.ndarray:
         """Centre (x, y) at run time ``t`` [s]; (n, 2) for n times."""
-        k = np.asarray(self.keyframes, float)
+        k = self._keys
         tau = self.path_time(t)
         return np.stack((np.interp(tau, k[:, 0], k[:, 1]), np.interp(tau, k[:, 0], k[:, 2])),
                         axis=-1)
 
     def velocity(self, t: float) -> np.ndarray:
         """Velocity (vx, vy) at run time ``t`` [m/s] (that of the segment it is on)."""
-        k = np.asarray(self.keyframes, float)
+        k = self._keys
         tau = float(self.path_time(t))
         if len(k) < 2 or (not self.loop and (tau >= self.period or t + self.offset < 0.0)):
             return np.zeros(2)
