@@ -38,6 +38,37 @@ def test_grid_message_keeps_geometry_and_maps_log_odds_to_percent():
     assert (data == -1).sum() == 398
 
 
+def test_grid_and_markers_of_a_corrected_memory_are_drawn_in_odom():
+    """With a drift correction (the memory's frame = odom turned by 0.1 rad and moved),
+    the grid's origin and every marker carry the memory frame's pose in odom, so a
+    memory point lands where odom has it."""
+    from subapf_planner.core.command import Command
+    from subapf_planner.core.planner import PlanResult
+    from subapf_planner.core.robot import compose, invert, to_parent
+    from subapf_planner.core.status import Status
+    from subapf_planner.ros.markers import markers_from_result
+    correction = (0.3, -0.2, 0.1)
+    in_odom = invert(correction)
+    grid = OccupancyGrid(0.1, 2.0)
+    msg = grid_to_msg(grid, 'odom', Time(), in_odom)
+    o = msg.info.origin
+    expect = compose(in_odom, (-1.0, -1.0, 0.0))
+    assert (o.position.x, o.position.y) == pytest.approx(expect[:2])
+    assert 2 * math.atan2(o.orientation.z, o.orientation.w) == pytest.approx(-0.1)
+    point = np.array([1.0, 2.0])
+    result = PlanResult(Command(0.1, 0.0, Status.DRIVING), chosen_point=point,
+                        obstacles=point[None], pose=np.array([1.0, 2.0, 0.0]),
+                        correction=correction)
+    markers = {m.ns: m for m in markers_from_result(result, 'odom', Time(), 0.25).markers}
+    chosen = markers['chosen_point'].pose.position
+    assert (chosen.x, chosen.y) == pytest.approx(to_parent(in_odom, point)[0])
+    obs = markers['obstacles']
+    yaw = 2 * math.atan2(obs.pose.orientation.z, obs.pose.orientation.w)
+    drawn = to_parent((obs.pose.position.x, obs.pose.position.y, yaw),
+                      [[obs.points[0].x, obs.points[0].y]])
+    np.testing.assert_allclose(drawn[0], to_parent(in_odom, point)[0], atol=1e-9)
+
+
 def test_path_message_orients_each_pose_along_the_path():
     pts = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0]])
     msg = path_to_msg(pts, 'odom', Time())

@@ -4,6 +4,7 @@ the paper's method (the progress checker gives the goal up), with the same param
 import pytest
 
 from subapf_planner.core.config import PlannerConfig
+from subapf_planner.core.loop import Supervision
 from subapf_planner.core.status import Outcome
 from subapf_planner.sim.episode import run_episode
 from subapf_planner.sim.world import parse_world
@@ -33,19 +34,22 @@ def test_default_reaches_what_the_paper_method_abandons(family, index):
     assert paper.final_distance > 1.0
 
 
-def test_a_goal_walled_in_stops_with_goal_unreachable():
+def test_a_goal_walled_in_stops_with_goal_unreachable_then_gives_up():
     """Unknown space counts as free, so the robot first drives round the box; once it
-    has seen every side it stops, with goal_unreachable, and stays stopped."""
+    has seen every side it stops, with goal_unreachable, stays stopped, and after
+    unreachable_timeout ends the attempt (outcome unreachable, before the time limit)."""
     doc = {'name': 'walled', 'start': [0.0, 0.0, 0.0], 'goal': [2.0, 0.0], 'time_limit': 60,
            'obstacles': [{'box': {'center': [2.0, 0.6], 'size': [1.4, 0.1]}},
                          {'box': {'center': [2.0, -0.6], 'size': [1.4, 0.1]}},
                          {'box': {'center': [1.35, 0.0], 'size': [0.1, 1.3]}},
                          {'box': {'center': [2.65, 0.0], 'size': [0.1, 1.3]}}]}
-    result = run_episode(parse_world(doc), PlannerConfig())
-    assert result.outcome is Outcome.TIMEOUT                 # never abandoned, never inside
+    result = run_episode(parse_world(doc), PlannerConfig(),
+                         limits=Supervision(unreachable_timeout=10.0))
+    assert result.outcome is Outcome.UNREACHABLE             # given up, never inside
+    assert result.time_s < 60.0
     stopped = result.statuses.get('goal_unreachable', 0)
-    assert stopped >= 50                                     # the last 10 s at least
-    moved = result.path[-stopped:, :2] - result.path[-1, :2]
+    assert stopped >= 50                                     # 10 s of it, then given up
+    moved = result.path[-50:, :2] - result.path[-1, :2]
     assert abs(moved).max() < 0.05                           # standing still meanwhile
 
 

@@ -13,11 +13,12 @@ import rclpy
 from rclpy.parameter import Parameter
 from sensor_msgs.msg import LaserScan
 
-from subapf_planner.core.command import forward_blocked
+from subapf_planner.core.command import Command, forward_blocked
 from subapf_planner.core.config import METHODS, PlannerConfig
-from subapf_planner.core.loop import DecisionLoop
-from subapf_planner.core.planner import Planner, plan
+from subapf_planner.core.loop import DecisionLoop, Supervision
+from subapf_planner.core.planner import Planner, PlanResult, plan
 from subapf_planner.core.scan import Scan, geometry_warning
+from subapf_planner.core.status import State, Status
 from subapf_planner.ros.planner_node import PlannerNode
 
 pytestmark = pytest.mark.node
@@ -265,6 +266,32 @@ def test_goal_behind_a_wall_without_progress_becomes_stuck():
         states.append(ctl.tick(0.2 * k).text)
     assert states[-1] == 'stuck: no progress, goal abandoned'
     assert ctl.tick(4.0).command == (0.0, 0.0)
+
+
+def test_goal_unreachable_is_given_up_after_its_timeout_unless_a_way_opens():
+    """goal_unreachable for unreachable_timeout ends the attempt (state unreachable,
+    zero velocity, and it stays so); a cycle with a way restarts the clock; the same
+    goal sent again tries again."""
+    ctl = DecisionLoop(CFG, Supervision(unreachable_timeout=3.0))
+    ctl.set_goal(np.array([5.0, 0.0]))
+    script = iter([Status.GOAL_UNREACHABLE] * 10 + [Status.DRIVING]
+                  + [Status.GOAL_UNREACHABLE] * 30)
+    ctl.planner.step = lambda *a, **k: PlanResult(Command(0.0, 0.0, next(script)))
+    scan = Scan(np.full(360, np.inf), 0.0, math.pi / 180, 0.12, 3.5, 0.0)
+    texts = []
+    for k in range(41):   # ticks 0.25 s apart (exact in binary)
+        ctl.update_scan(scan, 0.25 * k)
+        ctl.update_odom(0.25 * k, np.zeros(3), 0.25 * k)
+        texts.append(ctl.tick(0.25 * k).text)
+    assert texts[:10] == ['stopped: goal_unreachable'] * 10    # 2.5 s: still waiting
+    assert texts[10] == 'driving: driving'                      # a way: the clock restarts
+    given_up = next(k for k, t in enumerate(texts) if t.startswith('unreachable'))
+    assert given_up == 11 + 13                  # more than 3 s of it since tick 11
+    assert texts[given_up] == 'unreachable: no way to the goal for 3 s, goal abandoned'
+    assert all(t == texts[given_up] for t in texts[given_up:])
+    assert ctl.tick(9.0).command == (0.0, 0.0)
+    assert ctl.set_goal(np.array([5.0, 0.0]))                  # sent again: a new attempt
+    assert ctl.state is State.DRIVING
 
 
 def test_tf_frames_follow_rep105():

@@ -87,3 +87,35 @@ def a_ranges(cfg, box):
 def test_bad_sim_config():
     with pytest.raises(ValueError, match='range_noise'):
         SimConfig(range_noise=-1.0)
+
+
+def _drive(cfg, commands):
+    """Run (v, w, seconds) commands; returns (true, odometry) poses after each 0.2 s."""
+    true, odom = [], []
+    with BurgerSim(world(), cfg) as sim:
+        for v, w, seconds in commands:
+            for _ in range(int(round(seconds / 0.2))):
+                sim.set_command(v, w)
+                sim.step(0.2)
+                true.append(sim.true_pose())
+                odom.append(sim.odometry()[0])
+    return np.array(true), np.array(odom)
+
+
+def test_odometry_drift_grows_as_configured():
+    """+2 % distance: odometry's distance from the start is 1.02 x the true one all along
+    (the error grows with the distance); +3 % turn rate: its heading turns 1.03 x the
+    true turn; with neither, odometry is the truth."""
+    cfg = SimConfig(odom_distance_scale=1.02, odom_yaw_scale=1.03)
+    true, odom = _drive(cfg, [(0.2, 0.0, 10.0)])
+    d_true = np.hypot(*(true[:, :2] - true[0, :2]).T)[5:]
+    d_odom = np.hypot(*(odom[:, :2] - odom[0, :2]).T)[5:]
+    np.testing.assert_allclose(d_odom / d_true, 1.02, atol=2e-3)
+    err = np.hypot(*(odom[:, :2] - true[:, :2]).T)
+    assert err[-1] > 0.03 and err[-1] > 3 * err[len(err) // 4]        # it grows
+    true, odom = _drive(cfg, [(0.0, 1.0, 4.0)])
+    turned_true = np.unwrap(true[:, 2]) - true[0, 2]
+    turned_odom = np.unwrap(odom[:, 2]) - odom[0, 2]
+    assert turned_odom[-1] / turned_true[-1] == pytest.approx(1.03, abs=2e-3)
+    true, odom = _drive(SimConfig(), [(0.2, 0.5, 4.0)])
+    np.testing.assert_array_equal(true, odom)

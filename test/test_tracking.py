@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from subapf_planner.core.config import PlannerConfig
-from subapf_planner.core.evasion import evade, rollout
+from subapf_planner.core.evasion import Escape, evade, rollout, rollouts
 from subapf_planner.core.planner import Planner
 from subapf_planner.core.scan import Scan
 from subapf_planner.core.tracking import Tracker, Tracks
@@ -110,13 +110,14 @@ def test_something_coming_at_a_standing_robot_makes_it_back_off():
     backs away; with a wall right behind it, it turns aside instead of reversing into
     the wall; with reversing off it never backs."""
     pose = np.array([0.0, 0.0, 0.0])
-    v, w = evade(pose, (0.0, 0.0), head_on(), np.zeros((0, 2)), CFG, blocked_ahead=False)
+    v, w = evade(pose, (0.0, 0.0), head_on(), np.zeros((0, 2)), CFG,
+                 blocked_ahead=False).command
     assert v < 0.0
     wall_behind = np.column_stack((np.full(20, -0.2), np.linspace(-1, 1, 20)))
-    v, w = evade(pose, (0.0, 0.0), head_on(), wall_behind, CFG, blocked_ahead=False)
+    v, w = evade(pose, (0.0, 0.0), head_on(), wall_behind, CFG, blocked_ahead=False).command
     assert v >= 0.0 and w != 0.0
     v, w = evade(pose, (0.0, 0.0), head_on(), np.zeros((0, 2)),
-                 CFG.replace(reverse_speed=0.0), blocked_ahead=False)
+                 CFG.replace(reverse_speed=0.0), blocked_ahead=False).command
     assert v >= 0.0
 
 
@@ -127,7 +128,7 @@ def test_a_plan_that_keeps_clear_is_kept():
     assert evade(pose, (0.2, 0.0), away, np.zeros((0, 2)), CFG, False) is None
     # straight ahead into a walker coming the other way: replaced by one that keeps clear
     alt = evade(pose, (0.2, 0.0), head_on(0.2, 1.0), np.zeros((0, 2)), CFG, False)
-    assert alt is not None and alt != (0.2, 0.0)
+    assert alt is not None and alt.command != (0.2, 0.0)
 
 
 def test_rollout_is_a_unicycle():
@@ -137,3 +138,73 @@ def test_rollout_is_a_unicycle():
     np.testing.assert_allclose(path[-1], [r, r], atol=1e-9)
     np.testing.assert_allclose(rollout(np.array([1.0, 0.0, math.pi]), 0.1, 0.0, 1.0)[-1],
                                [0.9, 0.0], atol=1e-12)
+
+
+def test_turn_then_straight_rollout_is_exact():
+    """A quarter of a turn at pi/4 rad/s for 1 s, then 1 s straight: the arc's end,
+    then 0.2 m along the new heading (the per-step chord is exact)."""
+    w = math.pi / 4
+    path = rollouts(np.zeros(3), np.array([0.2]), np.array([[w] * 5 + [0.0] * 5]))[0]
+    r = 0.2 / w
+    arc_end = np.array([r * math.sin(w), r * (1 - math.cos(w))])
+    np.testing.assert_allclose(path[4], arc_end, atol=1e-12)
+    np.testing.assert_allclose(path[-1], arc_end + 0.2 * np.array([math.cos(w), math.sin(w)]),
+                               atol=1e-12)
+
+
+def corridor_walls(half_width=0.67):
+    x = np.linspace(-1.0, 4.0, 100)
+    return np.vstack([np.column_stack((x, np.full_like(x, s * half_width))) for s in (1, -1)])
+
+
+def test_head_on_in_a_corridor_steps_to_the_wider_side_and_keeps_to_it():
+    """A walker (r 0.25 m) coming down a 1.34 m corridor 9 cm left of its middle: 0.51 m
+    free on the right, 0.33 m on the left (too narrow for 0.21 m + 2 x 0.1 m). The escape
+    goes right, and the next cycle keeps the committed manoeuvre, one period on."""
+    walker = Tracks(np.array([[0.9, 0.09]]), np.array([[-0.16, 0.0]]), np.array([0.25]),
+                    np.array([True]), np.array([True]), np.zeros(0, np.int64))
+    pose = np.array([0.0, -0.02, 0.0])
+    esc = evade(pose, (0.22, 0.0), walker, corridor_walls(), CFG, False)
+    assert esc is not None
+    end = rollouts(pose, np.array([esc.v]), np.array([esc.turn]))[0, -1]
+    assert end[1] < -0.2                                          # to the right (y < 0)
+    nxt = esc.advanced()
+    assert len(nxt.turn) == len(esc.turn) and nxt.turn[:-1] == esc.turn[1:]
+    moved = Tracks(walker.position + 0.2 * walker.velocity, walker.velocity, walker.radius,
+                   walker.moving, walker.held, walker.point_track)
+    pose2 = np.array([*rollouts(pose, np.array([esc.v]), np.array([esc.turn]))[0, 0],
+                      pose[2] + esc.turn[0] * 0.2])
+    again = evade(pose2, (0.22, 0.0), moved, corridor_walls(), CFG, False, nxt)
+    assert again == nxt
+
+
+def test_escape_command_is_its_first_step():
+    assert Escape(0.1, (0.5, 0.0)).command == (0.1, 0.5)
+    assert Escape(0.1, (0.5, 0.0)).advanced() == Escape(0.1, (0.0, 0.0))
+
+
+def test_a_walker_along_a_mapped_wall_is_its_own_cluster_and_new_ones_move_sooner():
+    """Someone walking 5 cm from a wall that the memory already holds: the wall's points
+    (on established cells) are not clustered, so the walker is tracked alone. Appearing
+    in seen-free space, it is a mover after 0.15 m (NEW_MOVE_DISTANCE); the same walk
+    over unknown cells needs 0.3 m."""
+    v = np.array([0.0, 0.2])
+    wall = np.column_stack((np.full(60, 1.3), np.linspace(-1.5, 1.5, 60)))
+
+    def moving_from(free_log_odds):
+        tr = Tracker(0.15, 1.2, 0.6, 0.04)
+        for k in range(12):
+            walker = disc_points(np.array([1.0, -0.6]) + v * 0.2 * k, 0.25)
+            pts = np.vstack([walker, wall])
+            lo = np.concatenate([np.full(len(walker), free_log_odds), np.full(len(wall), 3.5)])
+            tracks = tr.update(pts, 0.2 * k, lo)
+            assert (tracks.point_track[len(walker):] == -1).all()   # the wall: no track
+            if tracks.moving.any():
+                assert tracks.moving_points[:len(walker)].all()
+                return k
+        return None
+    new, unknown = moving_from(-1.0), moving_from(0.0)
+    assert new is not None and unknown is not None
+    walked = 0.2 * 0.2   # [m] per scan
+    assert walked * new >= 0.15 - 1e-9 and new < unknown
+    assert walked * unknown >= 0.3 - 1e-9

@@ -57,7 +57,7 @@ def test_suite_round_robin_names_and_sub_seeds():
         worldgen.suite(0, 0)
 
 
-@pytest.mark.parametrize('family', worldgen.FAMILIES)
+@pytest.mark.parametrize('family', worldgen.FAMILIES + worldgen.BUILDING_FAMILIES)
 def test_every_family_parses_and_is_solvable(family):
     for seed in SEEDS:
         g = worldgen.generate_world(family, seed, f'{family}_{seed:03d}')
@@ -107,6 +107,16 @@ def test_zigzag_corridor_width_from_geometry():
         assert 0.5 - 0.03 <= width <= 1.0 + 1e-6
         # walls close the corridor: no straight way and a longer geodesic
         assert solvability.geodesic_length(world) > math.dist(world.start[:2], world.goal) + 0.5
+
+
+def test_building_goes_from_room_to_room_through_doors():
+    """Start and goal in different rooms: every way passes a door (0.6-0.9 m; furniture
+    may narrow it further, never below the solvability margin) and is a walk of metres."""
+    for seed in range(6):
+        world = parse_world(worldgen.generate('building', seed))
+        assert 0.31 - 0.03 <= solvability.bottleneck_width(world) <= 0.9 + 0.03
+        assert solvability.geodesic_length(world) >= 5.0
+        assert len(world.obstacles) >= 10
 
 
 @pytest.mark.parametrize('family', ['u_trap', 'c_trap'])

@@ -110,7 +110,7 @@ class PlannerConfig:
                               "so eq. (13)'s repulsion bends the path but cannot turn it back "
                               'in a passage narrower than 2 d0)', '', 0.0, 100.0)
     map_size: float = param(20.0, 'Side of the square occupancy window that follows the '
-                            'robot (memory bound: (map_size/map_resolution)^2 * 4 bytes)',
+                            'robot (memory bound: (map_size/map_resolution)^2 * 14 bytes)',
                             'm', 2.0, 200.0)
     map_resolution: float = param(0.05, 'Occupancy cell size', 'm', 0.01, 0.5)
     field_coarsening: int = param(2, 'The navigation field is marched on blocks of this '
@@ -128,6 +128,10 @@ class PlannerConfig:
     field_period: float = param(1.0, 'Shortest time between two field computations (sooner '
                                 'for a new goal, or when the robot leaves the patch)', 's',
                                 0.0, 60.0)
+    scan_alignment: bool = param(True, 'Match each scan to the memory before it is written '
+                                 '(core/alignment.py): drifting wheel odometry is corrected, '
+                                 'and the memory, the field and the goal live in the '
+                                 'corrected frame (with the geodesic attraction)')
     # --- moving obstacles (core/tracking.py, core/evasion.py) ------------------------
     track_moving: bool = param(True, 'Track moving obstacles from the scans (clusters, '
                                'constant-velocity Kalman filters): their points stay out of '

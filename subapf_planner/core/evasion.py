@@ -6,19 +6,23 @@ layer rolls the command out for ``prediction_horizon`` seconds (a unicycle at
 constant (v, w), ROLLOUT_DT steps) against each moving track's constant-velocity
 prediction (core/tracking.py): the gap between the footprint and the track's
 disc must stay above ``moving_clearance``. When it does not, a small set of
-escape commands is rolled out the same way: forward, slower, turning, standing
-still, and backing up at ``reverse_speed`` (the burger backs at up to 0.22
-m/s); a candidate is admissible only if its first EVASION_COMMIT seconds keep
-``robot_radius + STATIC_MARGIN`` from every laser point that is not a moving
-track's, and the safety corridor does not block its forward speed. Among the
-admissible ones that keep the clearance, the one closest to the planned command
-wins (the robot steps aside rather than turns back); when none keeps it, the one
-with the largest gap (it never stands still in an obstacle's way while a way out
-exists). Time-weighted so that a meeting soon counts more than one later.
+escape manoeuvres is rolled out the same way (all at once, as arrays): forward,
+slower, standing still and backing up at ``reverse_speed`` (the burger backs at
+up to 0.22 m/s), each straight or turning, for the whole horizon or for a while
+and then straight (stepping aside to pass). A candidate is admissible only if
+its first EVASION_COMMIT seconds keep ``robot_radius + STATIC_MARGIN`` from
+every laser point that is not a moving track's, and the safety corridor does
+not block its forward speed. Among the admissible ones that keep the clearance,
+the one closest to the planned command wins (the robot steps aside rather than
+turns back); when none keeps it, the one with the largest gap (it never stands
+still in an obstacle's way while a way out exists). Time-weighted so that a
+meeting soon counts more than one later. The chosen manoeuvre is committed: the
+next cycle considers it again, one period on.
 """
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 import math
 
 import numpy as np
@@ -38,75 +42,140 @@ STATIC_MARGIN = 0.02
 TIME_DISCOUNT = 0.05
 #: Angular rates of the escape candidates, as fractions of the top turn rate.
 TURN_FRACTIONS = (-0.6, -0.3, 0.0, 0.3, 0.6)
+#: How long a turning candidate turns before it drives straight [s] (None: the whole
+#: horizon, a constant arc). Turn-then-straight is how one steps aside to pass someone.
+TURN_TIMES = (None, 0.6, 1.2)
+#: When no escape keeps the clearance, the committed one stays while its gap is within
+#: this of the largest [m] (no flipping between escapes of nearly the same gap).
+HYSTERESIS = 0.02
+
+
+@dataclass(frozen=True)
+class Escape:
+    """An escape manoeuvre: forward speed ``v`` [m/s] and the turn rate of each rollout
+    step (k,) [rad/s]; the command now is (v, turn[0])."""
+
+    v: float
+    turn: tuple[float, ...]
+
+    @property
+    def command(self) -> tuple[float, float]:
+        return (self.v, self.turn[0])
+
+    def advanced(self) -> Escape:
+        """The same manoeuvre one planning period (ROLLOUT_DT) later."""
+        return Escape(self.v, self.turn[1:] + self.turn[-1:])
+
+
+def _steps(horizon: float) -> int:
+    return max(1, int(round(horizon / ROLLOUT_DT)))
+
+
+def rollouts(pose: NDArray[np.float64], v: NDArray[np.float64],
+             turn: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Positions (c, k, 2) [m] of c unicycles from ``pose`` (x, y, yaw), each at forward
+    speed v (c,) [m/s] and turn rate turn (c, k) [rad/s] held over each ROLLOUT_DT
+    step (first point one step ahead). Exact for piecewise-constant rates: a step's
+    chord has length v dt sinc(w dt / 2) along the heading at its middle."""
+    half = 0.5 * turn * ROLLOUT_DT
+    yaw0 = pose[2] + np.concatenate([np.zeros((len(v), 1)), np.cumsum(2.0 * half, axis=1)[:, :-1]],
+                                    axis=1)
+    chord = v[:, None] * ROLLOUT_DT * np.sinc(half / np.pi)
+    mid = yaw0 + half
+    return np.stack((pose[0] + np.cumsum(chord * np.cos(mid), axis=1),
+                     pose[1] + np.cumsum(chord * np.sin(mid), axis=1)), axis=-1)
 
 
 def rollout(pose: NDArray[np.float64], v: float, w: float, horizon: float) -> NDArray:
     """Positions (k, 2) [m] of a unicycle from ``pose`` (x, y, yaw) at constant (v, w),
     every ROLLOUT_DT up to ``horizon`` [s] (first point one step ahead)."""
-    t = np.arange(1, int(round(horizon / ROLLOUT_DT)) + 1) * ROLLOUT_DT
-    yaw = pose[2] + w * t
-    if abs(w) < 1e-9:
-        x = pose[0] + v * t * math.cos(pose[2])
-        y = pose[1] + v * t * math.sin(pose[2])
-    else:
-        x = pose[0] + v / w * (np.sin(yaw) - math.sin(pose[2]))
-        y = pose[1] - v / w * (np.cos(yaw) - math.cos(pose[2]))
-    return np.column_stack((x, y))
+    return rollouts(pose, np.array([v]), np.full((1, _steps(horizon)), w))[0]
+
+
+def moving_gaps(paths: NDArray[np.float64], tracks: Tracks,
+                robot_radius: float) -> NDArray[np.float64]:
+    """Smallest time-discounted gap [m] (c,) between the footprint along each of the
+    paths (c, k, 2) (one point per ROLLOUT_DT from one step ahead) and the moving tracks'
+    predicted discs; inf with none."""
+    m = tracks.moving
+    if not np.any(m):
+        return np.full(len(paths), math.inf)
+    t = (np.arange(paths.shape[1]) + 1)[:, None] * ROLLOUT_DT                 # (k, 1)
+    where = tracks.position[m][None] + t[..., None] * tracks.velocity[m][None]   # (k, n, 2)
+    d = paths[:, :, None, :] - where[None]                                      # (c, k, n, 2)
+    gap = np.hypot(d[..., 0], d[..., 1]) - tracks.radius[m] - robot_radius \
+        + TIME_DISCOUNT * t
+    return gap.min(axis=(1, 2))
 
 
 def moving_gap(path: NDArray[np.float64], tracks: Tracks, robot_radius: float) -> float:
-    """Smallest time-discounted gap [m] between the footprint along ``path`` (one point per
-    ROLLOUT_DT from one step ahead) and the moving tracks' predicted discs; inf with
-    none."""
-    m = tracks.moving
-    if not np.any(m):
-        return math.inf
-    t = (np.arange(len(path)) + 1)[:, None] * ROLLOUT_DT
-    where = tracks.position[m][None] + t[..., None] * tracks.velocity[m][None]   # (k, n, 2)
-    gap = np.hypot(*(path[:, None, :] - where).transpose(2, 0, 1)) - tracks.radius[m] \
-        - robot_radius
-    return float(np.min(gap + TIME_DISCOUNT * t))
+    """:func:`moving_gaps` of one path (k, 2)."""
+    return float(moving_gaps(path[None], tracks, robot_radius)[0])
 
 
-def _static_clear(pose: NDArray, path: NDArray, static: NDArray, radius: float) -> bool:
+def _static_clear(paths: NDArray, static: NDArray, radius: float) -> NDArray[np.bool_]:
+    """Per path (c, k, 2): its first EVASION_COMMIT seconds keep radius + STATIC_MARGIN
+    from every static point (m, 2)."""
     if len(static) == 0:
-        return True
-    k = max(1, int(round(EVASION_COMMIT / ROLLOUT_DT)))
-    near = path[:k]
-    d = np.hypot(*(near[:, None, :] - static[None]).transpose(2, 0, 1))
-    return bool(d.min() >= radius + STATIC_MARGIN)
+        return np.ones(len(paths), bool)
+    near = paths[:, :_steps(EVASION_COMMIT)]
+    d2 = ((near[:, :, None, :] - static[None, None]) ** 2).sum(axis=-1)
+    return d2.min(axis=(1, 2)) >= (radius + STATIC_MARGIN) ** 2
+
+
+def candidates(cfg: PlannerConfig) -> list[Escape]:
+    """The escape manoeuvres: each speed (top, half, standing, backing at reverse_speed)
+    with each turn rate of TURN_FRACTIONS, turning for each of TURN_TIMES."""
+    k = _steps(cfg.prediction_horizon)
+    speeds = [cfg.max_linear_velocity, 0.5 * cfg.max_linear_velocity, 0.0]
+    if cfg.reverse_speed > 0.0:
+        speeds.append(-cfg.reverse_speed)
+    out: list[Escape] = []
+    for v in speeds:
+        for f in TURN_FRACTIONS:
+            w = f * cfg.max_angular_velocity
+            for turning in (TURN_TIMES if f != 0.0 and v != 0.0 else (None,)):
+                n = k if turning is None else min(k, _steps(turning))
+                out.append(Escape(v, (w,) * n + (0.0,) * (k - n)))
+    return out
 
 
 def evade(pose: NDArray[np.float64], planned: tuple[float, float], tracks: Tracks,
           static: NDArray[np.float64], cfg: PlannerConfig, blocked_ahead: bool,
-          committed: tuple[float, float] | None = None) -> tuple[float, float] | None:
+          committed: Escape | None = None) -> Escape | None:
     """A replacement for the ``planned`` (v, w) when its rollout meets a moving track
     (see the module docstring), or None to keep it. ``static``: the laser points that
     are not moving tracks' (m, 2); ``blocked_ahead``: the safety corridor holds a point
     (forward candidates are then inadmissible); ``committed``: the escape of the last
-    cycle, kept while it still keeps the clearance (no dithering between escapes)."""
-    horizon = cfg.prediction_horizon
+    cycle, advanced one period, kept while it still keeps the clearance (no dithering
+    between escapes)."""
     v0, w0 = planned
-    if moving_gap(rollout(pose, v0, w0, horizon), tracks, cfg.robot_radius) \
+    if moving_gap(rollout(pose, v0, w0, cfg.prediction_horizon), tracks, cfg.robot_radius) \
             >= cfg.moving_clearance:
         return None
-    speeds = [cfg.max_linear_velocity, 0.5 * cfg.max_linear_velocity, 0.0]
-    if cfg.reverse_speed > 0.0:
-        speeds.append(-cfg.reverse_speed)
-    best, best_key = None, None
-    candidates = [(v, f * cfg.max_angular_velocity) for v in speeds for f in TURN_FRACTIONS]
-    for v, w in candidates:
-        if v > 0.0 and blocked_ahead:
-            continue
-        path = rollout(pose, v, w, horizon)
-        if v != 0.0 and not _static_clear(pose, path, static, cfg.robot_radius):
-            continue
-        gap = moving_gap(path, tracks, cfg.robot_radius)
-        # safe ones: the committed escape, else the closest to the plan; otherwise the
-        # largest gap
-        kept = committed is not None and (v, w) == committed
-        key = (0, -1.0 if kept else abs(v - v0) + 0.1 * abs(w - w0)) \
-            if gap >= cfg.moving_clearance else (1, -gap)
-        if best_key is None or key < best_key:
-            best, best_key = (v, w), key
-    return best
+    options = candidates(cfg)
+    k = len(options[0].turn)
+    if committed is not None and len(committed.turn) == k:
+        options.append(committed)
+    v = np.array([e.v for e in options])
+    turn = np.array([e.turn for e in options])
+    paths = rollouts(pose, v, turn)
+    ok = ~((v > 0.0) & blocked_ahead)
+    ok &= (v == 0.0) | _static_clear(paths, static, cfg.robot_radius)
+    if not np.any(ok):
+        return None
+    gap = np.where(ok, moving_gaps(paths, tracks, cfg.robot_radius), -math.inf)
+    kept = np.zeros(len(options), bool)
+    if committed is not None and options[-1] is committed:
+        kept[-1] = ok[-1]
+    safe = ok & (gap >= cfg.moving_clearance)
+    if np.any(safe):
+        # the committed escape, else the one closest to the plan (then the larger gap)
+        near = np.abs(v - v0) + 0.1 * np.abs(turn[:, 0] - w0)
+        score = np.where(kept, -1.0, near)
+        best = int(np.lexsort((-gap, np.where(safe, score, math.inf)))[0])
+    else:
+        best = int(np.argmax(gap))
+        if kept[-1] and gap[-1] >= gap[best] - HYSTERESIS:
+            best = len(options) - 1
+    return options[best]

@@ -9,7 +9,8 @@ Each ``tick`` supervises (goal, freshness, progress) and runs one planning step
 (core/planner.py: perceive, gate, plan).
 
 States (:class:`~.status.State`, the text of ``~/status`` before the colon):
-idle, waiting, driving, reached, stopped, stuck.
+idle, waiting, driving, reached, stopped, stuck (the progress checker gave the
+goal up), unreachable (no way through the memory for ``unreachable_timeout``).
 """
 
 from __future__ import annotations
@@ -49,6 +50,17 @@ class Supervision:
                                      '(state stuck)', 'm', 0.01, 10.0)
     progress_timeout: float = param(10.0, 'Progress checker: time allowed for '
                                     'progress_distance', 's', 1.0, 600.0)
+    recoveries: int = param(3, 'Times the progress checker, before it abandons the goal, '
+                            'marks the place the field leads into as tried (blocked in the '
+                            'field for avoid_time) so that the field leads along another way',
+                            '', 0, 100)
+    avoid_time: float = param(60.0, 'How long a tried place stays blocked in the field (then '
+                              'it opens again: a door that was only briefly blocked)', 's',
+                              1.0, 3600.0)
+    unreachable_timeout: float = param(30.0, 'A goal unreachable through the memory this '
+                                       'long ends the attempt (state unreachable); a way '
+                                       'that opens before (a door, someone who walked '
+                                       'off) restarts the clock', 's', 1.0, 3600.0)
 
     def __post_init__(self) -> None:
         check_fields(self)
@@ -82,9 +94,12 @@ class DecisionLoop:
         self.odom_time: float | None = None
         self.poses: deque = deque(maxlen=POSE_HISTORY)
         self.goal: np.ndarray | None = None
+        self.goal_in_map = False
         self.state = State.IDLE
         self.reason = 'no goal'
         self._progress: tuple[np.ndarray, float] | None = None
+        self._unreachable_since: float | None = None
+        self._tried = 0   # ways marked tried for this goal (recoveries)
 
     @property
     def cfg(self) -> PlannerConfig:
@@ -109,17 +124,21 @@ class DecisionLoop:
         """The state as ``~/status`` carries it: ``"state: reason"``."""
         return f'{self.state}: {self.reason}'
 
-    def set_goal(self, goal: np.ndarray) -> bool:
+    def set_goal(self, goal: np.ndarray, in_map: bool = False) -> bool:
         """A new goal resets the planner; the goal being driven to (or waited for: no
         inputs yet), sent again, does not, whenever it arrives (a stuck or stopped robot
-        retries it). Returns whether the goal was new."""
+        retries it). Returns whether the goal was new. ``goal`` (x, y) is in odom (the
+        place odom puts there now), or with ``in_map`` in the memory's frame (the place
+        in the world, as odom was at the start: what the scan alignment keeps still)."""
         goal = np.asarray(goal, float)
         if self.goal is not None and self.state in (State.DRIVING, State.WAITING) \
-                and np.hypot(*(goal - self.goal)) < SAME_GOAL:
+                and np.hypot(*(goal - self.goal)) < SAME_GOAL \
+                and in_map == self.goal_in_map:
             return False
-        self.goal = goal.copy()
+        self.goal, self.goal_in_map = goal.copy(), bool(in_map)
         self.planner.reset()
-        self._progress = None
+        self._progress = self._unreachable_since = None
+        self._tried = 0
         self._set(State.DRIVING, 'new goal')
         return True
 
@@ -129,7 +148,7 @@ class DecisionLoop:
         self.scan = self.scan_time = self.pose = self.odom_time = None
         self.poses.clear()
         self.planner.forget()
-        self._progress = None
+        self._progress = self._unreachable_since = None
         if self.goal is not None:
             self._set(State.DRIVING, 'clock jumped')
 
@@ -177,21 +196,51 @@ class DecisionLoop:
             return self._stop(State.STOPPED, 'scan is stale')
         if now - self.odom_time > lim.odom_timeout:
             return self._stop(State.STOPPED, 'odometry is stale')
-        if self.state is State.STUCK:
+        if self.state.gave_up:
             return Decision((0.0, 0.0), self.state, self.reason)
         result = self.planner.step(self.pose, self.goal, self.scan,
-                                   self.pose_at(self.scan.stamp), now)
+                                   self.pose_at(self.scan.stamp), now,
+                                   goal_in_map=self.goal_in_map)
         cmd = result.command
         if cmd.status is Status.REACHED:
             self.goal = None
             return self._stop(State.REACHED, 'goal within tolerance', result)
-        if cmd.status.stops:
-            return self._stop(State.STOPPED, cmd.status, result)
+        if self._unreachable_too_long(cmd.status, now):
+            tried = f' (every way tried: {self._tried})' if self._tried else ''
+            return self._stop(State.UNREACHABLE, f'no way to the goal for '
+                              f'{lim.unreachable_timeout:g} s{tried}, goal abandoned', result)
         if _giving_way(result, self.pose):
             self._progress = None
+        if cmd.status.stops:
+            if cmd.status is Status.NO_SAFE_MOVE and self._no_progress(now):
+                return self._recover(result, (0.0, 0.0), now)   # standing at a gap
+            return self._stop(State.STOPPED, cmd.status, result)
         if self._no_progress(now):
-            return self._stop(State.STUCK, 'no progress, goal abandoned', result)
+            return self._recover(result, (cmd.v, cmd.w), now)
         return self._decide((cmd.v, cmd.w), State.DRIVING, cmd.status, result)
+
+    def _recover(self, result: PlanResult, command: tuple[float, float],
+                 now: float) -> Decision:
+        """No progress: mark the way ahead tried (Planner.avoid_ahead) and go on, at most
+        ``recoveries`` times for a goal; then abandon it (state stuck)."""
+        lim = self.limits
+        if self._tried < lim.recoveries and self.planner.avoid_ahead(now + lim.avoid_time):
+            self._tried += 1
+            self._progress = None
+            return self._decide(command, State.DRIVING,
+                                f'no progress: the way ahead marked tried ({self._tried} of '
+                                f'{lim.recoveries}), another way', result)
+        return self._stop(State.STUCK, 'no progress, goal abandoned', result)
+
+    def _unreachable_too_long(self, status: Status, now: float) -> bool:
+        """Whether ``goal_unreachable`` has lasted longer than unreachable_timeout
+        (any other status restarts the clock)."""
+        if status is not Status.GOAL_UNREACHABLE:
+            self._unreachable_since = None
+            return False
+        if self._unreachable_since is None:
+            self._unreachable_since = now
+        return now - self._unreachable_since > self.limits.unreachable_timeout
 
     def _no_progress(self, now: float) -> bool:
         if self._progress is None or np.hypot(*(self.pose[:2] - self._progress[0])) >= \
@@ -202,8 +251,10 @@ class DecisionLoop:
 
 
 def _giving_way(result: PlanResult, pose: np.ndarray) -> bool:
-    """A moving track is within GIVING_WAY_DISTANCE of the robot."""
+    """A moving track is within GIVING_WAY_DISTANCE of the robot (at ``pose`` in odom,
+    or the result's own pose: the tracks are in the memory's frame)."""
     t = result.tracks
     if not np.any(t.moving):
         return False
+    pose = pose if result.pose is None else result.pose
     return bool(np.min(np.hypot(*(t.position[t.moving] - pose[:2]).T)) < GIVING_WAY_DISTANCE)

@@ -15,14 +15,20 @@ import math
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from .alignment import DistanceField, Match, align, distance_field
 from .config import PlannerConfig
 from .navigation import NavigationField, compute_field
 from .occupancy import OccupancyGrid
-from .robot import compose
-from .scan import Scan
+from .robot import compose, to_parent
+from .scan import Scan, scan_to_points
 
 #: Goals closer than this are the same goal (the field's, the controller's) [m].
 SAME_GOAL = 1e-3
+#: The alignment's distance field is made anew after this many scans (new walls join
+#: it) or when a scan reaches beyond it ...
+DISTANCE_FIELD_SCANS = 5
+#: ... and covers this much around the scan that made it [m].
+DISTANCE_FIELD_MARGIN = 1.0
 
 
 class NavigationMemory:
@@ -37,6 +43,10 @@ class NavigationMemory:
         self._scan_stamp: float | None = None
         self.recomputed = False   # whether the last field_for() computed a new field
         self.computations = 0     # fields computed so far
+        self._distance: DistanceField | None = None   # the alignment's, and its age
+        self._distance_age = 0
+        #: Places tried and not passed: (x, y, radius [m], until [s]) (see ``avoid``).
+        self.avoided: list[tuple[float, float, float, float]] = []
 
     def reconfigure(self, cfg: PlannerConfig) -> None:
         """A new configuration; a new map size or resolution starts an empty map."""
@@ -51,6 +61,8 @@ class NavigationMemory:
         self.grid = OccupancyGrid(self.cfg.map_resolution, self.cfg.map_size)
         self.field, self._field_key, self._field_time = None, None, -math.inf
         self._scan_stamp = None
+        self._distance, self._distance_age = None, 0
+        self.avoided = []
 
     def integrate(self, scan: Scan, scan_pose: ArrayLike, goal: ArrayLike | None = None,
                   transient: NDArray[np.bool_] | None = None) -> bool:
@@ -64,6 +76,58 @@ class NavigationMemory:
         self.grid.update(scan, compose(scan_pose, self.cfg.laser_mount), self.cfg.obstacle_range,
                          transient)
         return True
+
+    def align(self, scan: Scan, predicted: ArrayLike) -> Match:
+        """Match ``scan`` (its geometry checked) to the map: the pose of base_footprint
+        (core/alignment.py) from the ``predicted`` one (x, y, yaw) in the map's frame.
+        The distance field is reused for DISTANCE_FIELD_SCANS scans while it covers the
+        scan."""
+        base = scan_to_points(scan, (0.0, 0.0, 0.0), self.cfg.laser_mount,
+                              self.cfg.obstacle_range)
+        pred = np.asarray(predicted, float)
+        if len(base) == 0:
+            return align(base, pred, None)
+        here = to_parent(pred, base)
+        f = self._distance
+        reach = np.array([0.0, 0.0]) if f is None else f.origin + np.array(
+            f.values.shape[::-1]) * f.resolution
+        stale = f is None or self._distance_age >= DISTANCE_FIELD_SCANS or np.any(
+            here.min(axis=0) < f.origin) or np.any(here.max(axis=0) > reach)
+        if stale:
+            g = self.grid
+            self._distance = distance_field(g.log_odds, g.origin, g.resolution, here,
+                                            DISTANCE_FIELD_MARGIN, g.hit_offset)
+            self._distance_age = 0
+        self._distance_age += 1
+        return align(base, pred, self._distance)
+
+    def avoid(self, point: ArrayLike, radius: float, until: float) -> None:
+        """Block the cells within ``radius`` [m] of ``point`` in the navigation field
+        until time ``until`` [s] (a place the robot could not pass: the field then leads
+        along the next way; the map itself is not changed, so once the time is up the
+        place is open again)."""
+        self.avoided.append((float(point[0]), float(point[1]), float(radius), float(until)))
+        self._field_key = None
+
+    def _blocked(self, now: float | None) -> NDArray[np.bool_]:
+        """The occupied cells plus the avoided places still in force at ``now``."""
+        occ = self.grid.occupied()
+        if now is not None:
+            self.avoided = [a for a in self.avoided if now < a[3]]
+        if not self.avoided:
+            return occ
+        res, origin = self.grid.resolution, self.grid.origin
+        for x, y, r, _ in self.avoided:
+            c0, r0 = (int(v) for v in np.floor((np.array([x, y]) - r - origin) / res))
+            c1, r1 = (int(v) + 1 for v in np.floor((np.array([x, y]) + r - origin) / res))
+            c0, r0 = max(c0, 0), max(r0, 0)
+            c1, r1 = min(c1, occ.shape[1]), min(r1, occ.shape[0])
+            if c0 >= c1 or r0 >= r1:
+                continue
+            cy = origin[1] + (np.arange(r0, r1) + 0.5) * res
+            cx = origin[0] + (np.arange(c0, c1) + 0.5) * res
+            occ[r0:r1, c0:c1] |= (cx[None] - x) ** 2 + (cy[:, None] - y) ** 2 <= r * r
+        return occ
 
     def clear(self, points: ArrayLike) -> None:
         """Cells under ``points`` (n, 2) [m] that are occupied become unknown: something
@@ -98,6 +162,8 @@ class NavigationMemory:
         module docstring; ``now`` None recomputes whenever the occupied cells changed."""
         p = np.asarray(position, float)[:2]
         g = np.asarray(goal, float)[:2]
+        if now is not None and any(now >= a[3] for a in self.avoided):
+            self._field_key = None   # an avoided place opens again
         key = (tuple(np.round(g / SAME_GOAL).astype(int)), self.grid.version)
         same_goal = self._field_key is not None and self._field_key[0] == key[0]
         fresh = same_goal and (key[1] == self._field_key[1] or (
@@ -106,7 +172,7 @@ class NavigationMemory:
         if fresh and (self.field is None or self._covers(p)):
             return self.field
         cfg = self.cfg
-        self.field = compute_field(self.grid.occupied(), self.grid.origin, self.grid.resolution,
+        self.field = compute_field(self._blocked(now), self.grid.origin, self.grid.resolution,
                                    g, p, inflation_radius=cfg.inflation_radius,
                                    clearance_band=cfg.inflation_band,
                                    coarsening=cfg.field_coarsening)

@@ -39,6 +39,8 @@ LOG_ODDS_MIN = -2.0
 LOG_ODDS_MAX = 3.5
 #: Distance kept between the robot and the window's edge before it recentres [m].
 EDGE_MARGIN = 3.0
+#: Returns over which a cell's mean return place is kept (OccupancyGrid.hit_offset).
+HIT_MEMORY = 20
 
 
 def cell_index(points: ArrayLike, origin: ArrayLike, resolution: float) -> NDArray[np.int64]:
@@ -64,6 +66,10 @@ class OccupancyGrid:
         self.resolution = float(resolution)
         self.cells = max(8, int(math.ceil(size / resolution)))
         self.log_odds = np.zeros((self.cells, self.cells), np.float32)
+        #: Mean place of the returns in each cell, from its centre (x, y) [m], over the
+        #: last HIT_MEMORY of them (the scan alignment's sub-cell wall position).
+        self.hit_offset = np.zeros((self.cells, self.cells, 2), np.float32)
+        self.hit_count = np.zeros((self.cells, self.cells), np.int16)
         self.origin = np.array([-0.5, -0.5]) * self.cells * self.resolution
         self.version = 0   # bumped whenever the occupied set (log odds > 0) changed
 
@@ -76,7 +82,7 @@ class OccupancyGrid:
     @property
     def nbytes(self) -> int:
         """Memory held by the grid [bytes]."""
-        return int(self.log_odds.nbytes)
+        return int(self.log_odds.nbytes + self.hit_offset.nbytes + self.hit_count.nbytes)
 
     def cell_of(self, points: ArrayLike) -> NDArray[np.int64]:
         """(row, col) of each point (n, 2) [m]; may lie outside the window."""
@@ -119,15 +125,18 @@ class OccupancyGrid:
         new_origin = np.round((centre - 0.5 * self.size) / self.resolution) * self.resolution
         d = np.round((new_origin - self.origin) / self.resolution).astype(int)  # (dx, dy)
         n = self.cells
-        shifted = np.zeros_like(self.log_odds)
         dx, dy = int(d[0]), int(d[1])
-        if abs(dx) < n and abs(dy) < n:
-            src_r = slice(max(dy, 0), n + min(dy, 0))
-            dst_r = slice(max(-dy, 0), n + min(-dy, 0))
-            src_c = slice(max(dx, 0), n + min(dx, 0))
-            dst_c = slice(max(-dx, 0), n + min(-dx, 0))
-            shifted[dst_r, dst_c] = self.log_odds[src_r, src_c]
-        self.log_odds = shifted
+        layers = []
+        for a in (self.log_odds, self.hit_offset, self.hit_count):
+            shifted = np.zeros_like(a)
+            if abs(dx) < n and abs(dy) < n:
+                src_r = slice(max(dy, 0), n + min(dy, 0))
+                dst_r = slice(max(-dy, 0), n + min(-dy, 0))
+                src_c = slice(max(dx, 0), n + min(dx, 0))
+                dst_c = slice(max(-dx, 0), n + min(-dx, 0))
+                shifted[dst_r, dst_c] = a[src_r, src_c]
+            layers.append(shifted)
+        self.log_odds, self.hit_offset, self.hit_count = layers
         self.origin = new_origin
         self.version += 1
 
@@ -174,8 +183,10 @@ class OccupancyGrid:
         y0 = (ly - self.origin[1]) / res - r0
         c, s = np.cos(a), np.sin(a)
         free = self._flat(x0 + c[beam] * k, y0 + s[beam] * k, box)
-        ends = self._flat(x0 + c[marked] * length[marked] / res,
-                          y0 + s[marked] * length[marked] / res, box)
+        end_cols = x0 + c[marked] * length[marked] / res
+        end_rows = y0 + s[marked] * length[marked] / res
+        ends = self._flat(end_cols, end_rows, box)
+        self._note_hits(end_cols, end_rows, box)
         # each touched cell changes once however many beams touch it; a return wins
         mark = np.zeros((r1 - r0) * (c1 - c0), np.int8)
         mark[free] = 1
@@ -190,6 +201,28 @@ class OccupancyGrid:
         window[rows, cols] = new
         if np.any((old > 0.0) != (new > 0.0)):
             self.version += 1
+
+    def _note_hits(self, cols: NDArray[np.float64], rows: NDArray[np.float64],
+                   box: tuple[int, int, int, int, bool]) -> None:
+        """Fold the returns at continuous (col, row) box coordinates into their cells'
+        mean offsets (a running mean over at most HIT_MEMORY returns)."""
+        r0, r1, c0, c1, _ = box
+        col, row = np.floor(cols).astype(np.int64), np.floor(rows).astype(np.int64)
+        ok = (row >= 0) & (row < r1 - r0) & (col >= 0) & (col < c1 - c0)
+        if not np.any(ok):
+            return
+        w = c1 - c0
+        flat = row[ok] * w + col[ok]
+        cells, inverse, k = np.unique(flat, return_inverse=True, return_counts=True)
+        off = np.column_stack((cols[ok] - col[ok] - 0.5, rows[ok] - row[ok] - 0.5)) \
+            * self.resolution
+        total = np.column_stack([np.bincount(inverse, off[:, i], len(cells)) for i in (0, 1)])
+        rr, cc = np.divmod(cells, w)
+        rr, cc = rr + r0, cc + c0
+        n = self.hit_count[rr, cc].astype(np.float64)
+        mean = (self.hit_offset[rr, cc] * n[:, None] + total) / (n + k)[:, None]
+        self.hit_offset[rr, cc] = mean
+        self.hit_count[rr, cc] = np.minimum(n + k, HIT_MEMORY)
 
     @staticmethod
     def _flat(cols: NDArray[np.float64], rows: NDArray[np.float64],

@@ -3,11 +3,14 @@
 One cycle of :meth:`Planner.step` (the decision loop, core/loop.py, calls it once
 per period):
 
-1. **perceive**: the scan's valid returns -> point obstacles in odom (scan.py,
-   with the laser mounting of robot.py); with ``attraction_field: geodesic``
-   (the default) the scan also goes into the occupancy memory (memory.py);
-   moving obstacles are tracked (tracking.py) and their points kept out of the
-   memory;
+1. **perceive**: with ``attraction_field: geodesic`` (the default) and
+   ``scan_alignment``, the scan is first matched to the occupancy memory
+   (alignment.py): the correction it finds (odom -> the memory's frame) places
+   the robot, the scan and the goal from then on, so drifting odometry does not
+   draw walls twice; the scan's valid returns -> point obstacles (scan.py, with
+   the laser mounting of robot.py); with the geodesic attraction the scan also
+   goes into the occupancy memory (memory.py); moving obstacles are tracked
+   (tracking.py) and their points kept out of the memory;
 2. **gate**: the inputs (:func:`input_status`: non-finite pose or goal; a scan
    with a bad geometry) and the goal (:func:`goal_status`: reached, inside an
    obstacle; with the memory, unreachable through it) each stop the robot with
@@ -34,19 +37,26 @@ import math
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from .alignment import Match
 from .apf import apf_step
 from .command import Command, forward_blocked, shape_command
 from .config import PlannerConfig
 from .dwa import dwa_command
-from .evasion import evade
-from .memory import NavigationMemory
+from .evasion import Escape, evade
+from .memory import SAME_GOAL, NavigationMemory
 from .navigation import NavigationField
+from .robot import compose, invert, to_parent
 from .sampling import SamplingResult, clearance, sample_and_choose
 from .scan import Scan, ScanError, scan_to_points, voxel_downsample
 from .status import Status
 from .tracking import NO_TRACKS, Tracker, Tracks
 
 _EMPTY = np.zeros((0, 2))
+#: A place tried and not passed (Planner.avoid_ahead): this far ahead along the field's
+#: descent [m] ...
+AVOID_AHEAD = 0.5
+#: ... a disc of this radius [m] (a door and its sides).
+AVOID_RADIUS = 0.35
 
 
 @dataclass(frozen=True)
@@ -65,6 +75,10 @@ class PlanResult:
     new_field: bool = False
     #: The tracked obstacles of this cycle's scan (core/tracking.py).
     tracks: Tracks = NO_TRACKS
+    #: The robot's pose (x, y, yaw) the cycle planned from, in the memory's frame ...
+    pose: NDArray[np.float64] | None = None
+    #: ... which is odom corrected by this (x, y, yaw) (the scan alignment; Planner.step).
+    correction: tuple[float, float, float] = (0.0, 0.0, 0.0)
 
 
 def input_status(pose: ArrayLike, goal: ArrayLike) -> Status | None:
@@ -184,7 +198,8 @@ class Planner:
         self.previous: tuple[float, float] = (0.0, 0.0)
         self.memory = NavigationMemory(cfg)
         self.tracker = _tracker(cfg)
-        self._escape: tuple[float, float] | None = None   # last cycle's escape command
+        self._escape: Escape | None = None   # the escape of the last cycle, if it evaded
+        self._clear_alignment()
 
     @property
     def cfg(self) -> PlannerConfig:
@@ -198,19 +213,34 @@ class Planner:
         self.memory.reconfigure(cfg)
 
     def reset(self) -> None:
-        """Forget the last command (after a stop, a new goal or a fault); the map stays."""
+        """Forget the last command and escape (after a stop, a new goal or a fault); the
+        map stays."""
         self.previous = (0.0, 0.0)
+        self._escape = None
 
     def forget(self) -> None:
         """Forget the last command, the map and the tracks (a restarted simulation)."""
         self.reset()
         self.memory.forget()
         self.tracker.reset()
+        self._clear_alignment()
+
+    def _clear_alignment(self) -> None:
+        #: The memory's frame in odom: the scan alignment's correction (x, y, yaw).
+        self.correction: tuple[float, float, float] = (0.0, 0.0, 0.0)
+        self.match: Match | None = None          # the last scan's alignment
+        self._aligned_stamp: float | None = None
+        self._goal: tuple[NDArray, NDArray] | None = None   # (in odom, in the memory's frame)
+        self._planned_from: NDArray | None = None   # the last cycle's pose (memory's frame)
 
     def step(self, pose: ArrayLike, goal: ArrayLike, scan: Scan,
-             scan_pose: ArrayLike | None = None, now: float | None = None) -> PlanResult:
+             scan_pose: ArrayLike | None = None, now: float | None = None,
+             goal_in_map: bool = False) -> PlanResult:
         """Perceive, gate and plan one cycle (module docstring) for the robot at ``pose``
-        (x, y, yaw) in odom driving to ``goal`` (x, y).
+        (x, y, yaw) in odom driving to ``goal`` (x, y) in odom (with ``goal_in_map``: in
+        the memory's frame). The result's points, field and ``pose`` are in the memory's
+        frame: odom corrected by ``result.correction`` (the identity without scan
+        alignment; the memory's frame is odom as it was at the start).
 
         ``scan_pose``: base_footprint's odom pose when the scan was taken (default
         ``pose``); a robot that moved since is planned for from ``pose``. ``now`` [s]
@@ -222,8 +252,12 @@ class Planner:
         status = input_status(pose, goal)
         if status is not None:
             return self._stop(PlanResult(Command(0.0, 0.0, status)))
-        scan_pose = pose if scan_pose is None else scan_pose
-        try:   # perceive
+        scan_pose = pose if scan_pose is None else np.asarray(scan_pose, float).ravel()
+        try:   # perceive: align (odom -> the memory's frame), then place the returns
+            if cfg.geodesic and cfg.scan_alignment:
+                self._align(scan, scan_pose)
+            pose, scan_pose = self.in_map(pose), self.in_map(scan_pose)
+            goal = goal if goal_in_map else self._anchored(goal)
             points = scan_to_points(scan, scan_pose, cfg.laser_mount, cfg.obstacle_range)
         except ScanError:
             return self._stop(PlanResult(Command(0.0, 0.0, Status.INVALID_SCAN)))
@@ -249,10 +283,53 @@ class Planner:
                 result = dataclasses.replace(result, new_field=new_field, tracks=tracks)
         if status is not Status.REACHED and np.any(tracks.moving) and cfg.method != 'dwa':
             result = self._out_of_the_way(pose, result, points)
+        else:
+            self._escape = None
+        result = dataclasses.replace(result, pose=pose, correction=self.correction)
+        self._planned_from = pose
         if result.command.status.stops:
             return self._stop(result)
         self.previous = (result.command.v, result.command.w)
         return result
+
+    def avoid_ahead(self, until: float) -> bool:
+        """Mark the place the navigation field leads the robot into next (AVOID_AHEAD
+        along its descent from the last cycle's pose, a disc of AVOID_RADIUS) as tried,
+        blocked in the field until ``until`` [s]; False without a field or a way."""
+        f, pose = self.memory.field, self._planned_from
+        if f is None or pose is None:
+            return False
+        path = f.path(pose[:2], max_length=2.0 * AVOID_AHEAD)
+        if len(path) < 2:
+            return False
+        along = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(path, axis=0).T))])
+        self.memory.avoid(path[min(int(np.searchsorted(along, AVOID_AHEAD)), len(path) - 1)],
+                          AVOID_RADIUS, until)
+        return True
+
+    def in_map(self, pose: ArrayLike) -> NDArray[np.float64]:
+        """An odom pose (x, y, yaw) in the memory's frame (odom corrected by the scan
+        alignment; odom itself without it)."""
+        return np.array(compose(self.correction, pose))
+
+    def _align(self, scan: Scan, scan_pose: NDArray) -> None:
+        """Match a new scan (not one already matched: same stamp) to the memory and
+        update the correction when the match is accepted (core/alignment.py)."""
+        if scan.stamp == self._aligned_stamp:
+            return
+        self._aligned_stamp = scan.stamp
+        predicted = self.in_map(scan_pose)
+        self.match = self.memory.align(scan, predicted)
+        if self.match.accepted and not np.array_equal(self.match.pose, predicted):
+            self.correction = compose(self.match.pose, invert(scan_pose))
+
+    def _anchored(self, goal: NDArray) -> NDArray[np.float64]:
+        """The goal (x, y) in the memory's frame: a goal given in odom is the place odom
+        had there when the goal came (the correction of then), and stays that place
+        while the correction changes."""
+        if self._goal is None or np.hypot(*(goal - self._goal[0])) >= SAME_GOAL:
+            self._goal = (goal.copy(), to_parent(self.correction, goal)[0])
+        return self._goal[1]
 
     def _track(self, scan: Scan, points: NDArray,
                now: float | None) -> tuple[Tracks, NDArray[np.bool_] | None]:
@@ -271,11 +348,12 @@ class Planner:
         cfg, tracks, cmd = self.cfg, result.tracks, result.command
         static = points[~tracks.moving_points]
         alt = evade(pose, (cmd.v, cmd.w), tracks, static, cfg,
-                    forward_blocked(pose, points, cfg), self._escape)
+                    forward_blocked(pose, points, cfg),
+                    None if self._escape is None else self._escape.advanced())
         self._escape = alt
         if alt is None:
             return result
-        return dataclasses.replace(result, command=Command(alt[0], alt[1], Status.EVADING))
+        return dataclasses.replace(result, command=Command(*alt.command, Status.EVADING))
 
     def _stop(self, result: PlanResult) -> PlanResult:
         self.reset()

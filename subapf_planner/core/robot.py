@@ -90,6 +90,14 @@ def compose(parent: ArrayLike, child: ArrayLike) -> tuple[float, float, float]:
     return (x + c * cx - s * cy, y + s * cx + c * cy, yaw + cyaw)
 
 
+def invert(pose: ArrayLike) -> tuple[float, float, float]:
+    """The pose of the parent frame in the frame whose pose is ``pose`` (x, y, yaw):
+    compose(pose, invert(pose)) is the identity."""
+    x, y, yaw = (float(v) for v in pose)
+    c, s = math.cos(yaw), math.sin(yaw)
+    return (-c * x - s * y, s * x - c * y, -yaw)
+
+
 def to_parent(pose: ArrayLike, points: ArrayLike) -> NDArray[np.float64]:
     """Points (n, 2) given in the frame whose pose is ``pose`` (x, y, yaw), expressed in
     the frame the pose is given in [m]."""

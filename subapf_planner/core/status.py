@@ -45,11 +45,18 @@ class State(StrEnum):
     REACHED = 'reached'
     STOPPED = 'stopped'
     STUCK = 'stuck'
+    #: The goal was unreachable through the memory for ``unreachable_timeout``: given up.
+    UNREACHABLE = 'unreachable'
 
     @property
     def halted(self) -> bool:
         """The robot is held still by a stop (worth a warning)."""
-        return self in (State.STOPPED, State.STUCK)
+        return self in (State.STOPPED, State.STUCK, State.UNREACHABLE)
+
+    @property
+    def gave_up(self) -> bool:
+        """The attempt has ended without the goal (until a goal is sent again)."""
+        return self in (State.STUCK, State.UNREACHABLE)
 
 
 class Outcome(StrEnum):
@@ -60,3 +67,6 @@ class Outcome(StrEnum):
     TIMEOUT = 'timeout'
     #: The planner gave the goal up (progress checker) before the time limit.
     ABANDONED = 'abandoned'
+    #: The planner ended the attempt: no way to the goal through its memory for
+    #: ``unreachable_timeout``.
+    UNREACHABLE = 'unreachable'

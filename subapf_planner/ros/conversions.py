@@ -14,6 +14,7 @@ from sensor_msgs.msg import LaserScan
 
 from ..bag.events import stamp_ns
 from ..core.occupancy import OccupancyGrid
+from ..core.robot import compose
 from ..core.scan import Scan
 
 
@@ -123,17 +124,22 @@ def cmd_from_msg(msg: Twist | TwistStamped) -> tuple[float, float]:
     return float(twist.linear.x), float(twist.angular.z)
 
 
-def grid_to_msg(grid: OccupancyGrid, frame: str, stamp: Time) -> GridMsg:
+def grid_to_msg(grid: OccupancyGrid, frame: str, stamp: Time,
+                frame_pose: tuple[float, float, float] = (0.0, 0.0, 0.0)) -> GridMsg:
     """The occupancy memory as nav_msgs/OccupancyGrid: occupancy probability 0-100 from
-    the log odds, -1 where nothing was ever seen; row-major from cell (0, 0)."""
+    the log odds, -1 where nothing was ever seen; row-major from cell (0, 0).
+    ``frame_pose``: the pose of the memory's frame in ``frame`` (the origin is turned
+    with it)."""
     msg = GridMsg()
     msg.header.frame_id = frame
     msg.header.stamp = stamp
     msg.info.map_load_time = stamp
     msg.info.resolution = float(grid.resolution)
     msg.info.width = msg.info.height = int(grid.cells)
-    msg.info.origin.position.x, msg.info.origin.position.y = (float(v) for v in grid.origin)
-    msg.info.origin.orientation.w = 1.0
+    x, y, yaw = compose(frame_pose, (float(grid.origin[0]), float(grid.origin[1]), 0.0))
+    msg.info.origin.position.x, msg.info.origin.position.y = x, y
+    msg.info.origin.orientation.z = math.sin(0.5 * yaw)
+    msg.info.origin.orientation.w = math.cos(0.5 * yaw)
     lo = grid.log_odds.astype(np.float64)
     data = np.rint(100.0 / (1.0 + np.exp(-lo))).astype(np.int8)
     data[lo == 0.0] = -1

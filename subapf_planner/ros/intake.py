@@ -10,8 +10,10 @@ in the same way:
   warning;
 * odometry with a non-finite pose is dropped; a stamp going back in time clears
   the pose history;
-* a goal in a frame other than ``odom_frame`` (or empty) or with a non-finite
-  position is refused (an error), the previous goal kept.
+* a goal in a frame other than ``odom_frame`` (or empty) or ``map_frame`` (the
+  memory's frame: odom as it was at the start, kept still by the scan
+  alignment), or with a non-finite position, is refused (an error), the
+  previous goal kept.
 """
 
 from __future__ import annotations
@@ -34,6 +36,8 @@ class Intake:
 
     laser_frame: str = 'base_scan'
     odom_frame: str = 'odom'
+    #: The name of the memory's frame (odom corrected by the scan alignment).
+    map_frame: str = 'map'
 
     def scan(self, loop: DecisionLoop, msg: LaserScan, now: float) -> str | None:
         """Take a scan handled at ``now`` [s]; a warning, or None."""
@@ -57,9 +61,10 @@ class Intake:
     def goal(self, loop: DecisionLoop, msg: PoseStamped) -> tuple[bool, str | None]:
         """Take a goal: (whether it is a new goal, the reason it was refused or None)."""
         goal = np.array([msg.pose.position.x, msg.pose.position.y], dtype=float)
-        if msg.header.frame_id not in ('', self.odom_frame):
-            return False, (f'goal in frame "{msg.header.frame_id}" refused: give it in '
-                           f'"{self.odom_frame}"')
+        frame = msg.header.frame_id
+        if frame not in ('', self.odom_frame, self.map_frame):
+            return False, (f'goal in frame "{frame}" refused: give it in '
+                           f'"{self.odom_frame}" or "{self.map_frame}"')
         if not np.all(np.isfinite(goal)):
             return False, 'goal with a non-finite position refused'
-        return loop.set_goal(goal), None
+        return loop.set_goal(goal, in_map=frame == self.map_frame), None

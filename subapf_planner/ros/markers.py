@@ -11,6 +11,7 @@ from std_msgs.msg import ColorRGBA
 from visualization_msgs.msg import Marker, MarkerArray
 
 from ..core.planner import PlanResult
+from ..core.robot import compose, invert
 from ..core.scan import voxel_downsample
 from ..sim.world import Box, Circle
 
@@ -31,12 +32,22 @@ def _points(xy: np.ndarray) -> list[Point]:
     return [Point(x=float(x), y=float(y), z=0.0) for x, y in np.asarray(xy).reshape(-1, 2)]
 
 
+def _placed(m: Marker, pose: tuple[float, float, float]) -> Marker:
+    """The marker with its pose composed after ``pose`` (x, y, yaw): its points, given in
+    the frame whose pose in the header's frame that is, drawn where they are."""
+    yaw = 2.0 * math.atan2(m.pose.orientation.z, m.pose.orientation.w)
+    x, y, yaw = compose(pose, (m.pose.position.x, m.pose.position.y, yaw))
+    m.pose.position.x, m.pose.position.y = x, y
+    m.pose.orientation.z, m.pose.orientation.w = math.sin(0.5 * yaw), math.cos(0.5 * yaw)
+    return m
+
+
 def markers_from_result(result: PlanResult, frame: str, stamp: Time,
-                        danger_distance: float, position: np.ndarray,
-                        voxel: float = 0.05) -> MarkerArray:
+                        danger_distance: float, voxel: float = 0.05) -> MarkerArray:
     """Obstacle points (voxel-downsampled, as the repulsion sees them), raw next move
-    point, samples coloured by score, chosen point and the danger circle around the
-    robot, for RViz or Foxglove."""
+    point, samples coloured by score, chosen point, the moving tracks and the danger
+    circle around the robot, for RViz or Foxglove, in ``frame`` (odom: each marker's
+    pose carries the memory frame's place in it, ``invert(result.correction)``)."""
     out = MarkerArray()
     obs = _marker('obstacles', 0, Marker.POINTS, frame, stamp, 0.03, (0.9, 0.2, 0.2, 1.0))
     obs.points = _points(voxel_downsample(result.obstacles, voxel))
@@ -65,10 +76,14 @@ def markers_from_result(result: PlanResult, frame: str, stamp: Time,
     out.markers.extend(track_markers(result, frame, stamp))
     ring = _marker('danger_circle', 0, Marker.LINE_STRIP, frame, stamp, 0.01,
                    (1.0, 0.0, 0.0, 0.5))
-    a = np.linspace(0.0, 2.0 * math.pi, 37)
-    ring.points = _points(np.column_stack((position[0] + danger_distance * np.cos(a),
-                                           position[1] + danger_distance * np.sin(a))))
+    if result.pose is not None:
+        a = np.linspace(0.0, 2.0 * math.pi, 37)
+        ring.points = _points(np.column_stack((result.pose[0] + danger_distance * np.cos(a),
+                                               result.pose[1] + danger_distance * np.sin(a))))
     out.markers.append(ring)
+    if result.correction != (0.0, 0.0, 0.0):
+        memory_frame = invert(result.correction)
+        out.markers = [_placed(m, memory_frame) for m in out.markers]
     return out
 
 

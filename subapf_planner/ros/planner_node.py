@@ -2,13 +2,15 @@
 
 Topics (relative, so namespaces and remapping work):
   in:  scan (sensor_msgs/LaserScan, sensor-data QoS), odom (nav_msgs/Odometry),
-       goal_pose (geometry_msgs/PoseStamped, in the odom frame)
+       goal_pose (geometry_msgs/PoseStamped, in the odom frame or map_frame)
   out: cmd_vel (geometry_msgs/TwistStamped, or Twist with
        enable_stamped_cmd_vel:=false), ~/status (std_msgs/String,
        "state: reason"), ~/markers (visualization_msgs/MarkerArray),
        ~/map (nav_msgs/OccupancyGrid, transient local, the occupancy memory),
        ~/plan (nav_msgs/Path, the navigation field's steepest descent, sent for each
-       new field and as the robot moves)
+       new field and as the robot moves), ~/correction (geometry_msgs/
+       TransformStamped map_frame -> odom: the scan alignment's drift correction);
+       markers, map and plan are drawn in odom
 
 The node only translates messages and parameters and drives one timer; the
 decisions are subapf_planner.core.loop's, the input checks ros/intake.py's.
@@ -19,7 +21,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 import sys
 
-from geometry_msgs.msg import PoseStamped, Twist, TwistStamped
+from geometry_msgs.msg import PoseStamped, TransformStamped, Twist, TwistStamped
 from nav_msgs.msg import OccupancyGrid as GridMsg
 from nav_msgs.msg import Odometry, Path
 import numpy as np
@@ -38,7 +40,8 @@ from ..core.config import ConfigError, PlannerConfig
 from ..core.loop import DecisionLoop, Supervision
 from ..core.navigation import thin_polyline
 from ..core.params import check_fields, param
-from .conversions import cmd_to_msg, grid_to_msg, path_to_msg
+from ..core.robot import invert, to_parent
+from .conversions import cmd_to_msg, grid_to_msg, path_to_msg, transform_msg
 from .intake import Intake
 from .markers import markers_from_result
 from .parameters import declare, read
@@ -78,6 +81,10 @@ class NodeOptions:
                                'when the robot moved 0.25 m or a second passed')
     laser_frame: str = param('base_scan', 'Expected scan frame_id; empty accepts any')
     odom_frame: str = param('odom', 'Frame of odometry and goals')
+    map_frame: str = param('map', "Name of the memory's frame (odom as it was at the start, "
+                           'kept still by scan_alignment): goals may be given in it, and '
+                           '~/correction is its transform to odom_frame (a topic, not /tf: '
+                           'a localiser may own map -> odom)')
 
     def __post_init__(self) -> None:
         check_fields(self)
@@ -96,7 +103,7 @@ class PlannerNode(Node):
         # a bad start value raises ConfigError naming it (exit code 2)
         self.options = read(self, NodeOptions)
         self.ctl = DecisionLoop(read(self, PlannerConfig), read(self, Supervision))
-        self.intake = Intake(self.options.laser_frame, self.options.odom_frame)
+        self.intake = self._intake()
         self._pending: dict[type, object] = {}   # groups validated by the on-set callback
         self.add_on_set_parameters_callback(self._validate_parameters)
         self.add_post_set_parameters_callback(self._apply_parameters)
@@ -107,6 +114,7 @@ class PlannerNode(Node):
         self.marker_pub = self.create_publisher(MarkerArray, '~/markers', 10)
         self.map_pub = self.create_publisher(GridMsg, '~/map', LATCHED)
         self.plan_pub = self.create_publisher(Path, '~/plan', 10)
+        self.correction_pub = self.create_publisher(TransformStamped, '~/correction', 10)
         self._map_time: float | None = None
         self._plan_sent: tuple | None = None   # (field, robot position, time) of ~/plan
         self._inputs = (
@@ -151,7 +159,7 @@ class PlannerNode(Node):
         if cfg.planning_frequency != self.ctl.cfg.planning_frequency:
             self.timer.timer_period_ns = int(cfg.period * 1e9)
         self.options = pending[NodeOptions]
-        self.intake = Intake(self.options.laser_frame, self.options.odom_frame)
+        self.intake = self._intake()
         self.ctl.cfg = cfg
         self.ctl.limits = pending[Supervision]
 
@@ -218,7 +226,12 @@ class PlannerNode(Node):
             cfg = self.ctl.cfg
             self.marker_pub.publish(markers_from_result(
                 decision.result, self.options.odom_frame, tick.to_msg(),
-                cfg.danger_distance, self.ctl.pose, cfg.voxel_size))
+                cfg.danger_distance, cfg.voxel_size))
+        if decision.result is not None and self.ctl.cfg.geodesic:
+            self.correction_pub.publish(transform_msg(
+                self.options.map_frame, self.options.odom_frame,
+                (*decision.result.correction[:2], 0.0), decision.result.correction[2],
+                tick.nanoseconds * 1e-9))
         self._publish_memory(decision, tick)
         if decision.state.halted and decision.text != self._last_state:
             self.get_logger().warn(decision.text)
@@ -231,20 +244,28 @@ class PlannerNode(Node):
         if not self.ctl.cfg.geodesic:
             return
         frame, now = self.options.odom_frame, tick.nanoseconds * 1e-9
-        field = decision.result.field if decision.result is not None else None
-        if self.options.publish_plan and field is not None and self.ctl.pose is not None:
-            here = self.ctl.pose[:2]
+        result = decision.result
+        field = result.field if result is not None else None
+        memory_frame = invert(self.ctl.planner.correction)   # its pose in odom
+        if self.options.publish_plan and field is not None and result.pose is not None:
+            here = result.pose[:2]
             last = self._plan_sent
             if last is None or last[0] is not field or now < last[2] \
                     or now - last[2] >= PLAN_PERIOD \
                     or np.hypot(*(here - last[1])) >= PLAN_SPACING:
                 self._plan_sent = (field, here.copy(), now)
                 self.plan_pub.publish(path_to_msg(
-                    thin_polyline(field.path(here), PLAN_SPACING), frame, tick.to_msg()))
+                    to_parent(memory_frame, thin_polyline(field.path(here), PLAN_SPACING)),
+                    frame, tick.to_msg()))
         if self.options.publish_map and (self._map_time is None or now < self._map_time
                                          or now - self._map_time >= 1.0 / self.options.map_rate):
             self._map_time = now
-            self.map_pub.publish(grid_to_msg(self.ctl.grid, frame, tick.to_msg()))
+            self.map_pub.publish(grid_to_msg(self.ctl.grid, frame, tick.to_msg(),
+                                             memory_frame))
+
+    def _intake(self) -> Intake:
+        o = self.options
+        return Intake(o.laser_frame, o.odom_frame, o.map_frame)
 
     def _publish_cmd(self, v: float, w: float, stamp=None) -> None:
         stamped = self.cmd_pub.msg_type is TwistStamped

@@ -27,6 +27,9 @@ from .outcome import outcome_of
 from .simulator import BurgerSim, SimConfig
 from .world import World
 
+#: How a run ends when the planner gives the goal up.
+GAVE_UP = {State.STUCK: Outcome.ABANDONED, State.UNREACHABLE: Outcome.UNREACHABLE}
+
 
 @dataclass(frozen=True)
 class EpisodeResult:
@@ -76,14 +79,15 @@ def run_episode(world: World, cfg: PlannerConfig, sim_cfg: SimConfig | None = No
                 time_limit: float | None = None, faults: ScanFaults | None = None,
                 limits: Supervision | None = None, label: str | None = None) -> EpisodeResult:
     """Drive the world's start to its goal; stop at the first outcome, or when the
-    planner abandons the goal (``Outcome.ABANDONED``). ``label`` names the method in
+    planner gives the goal up (``abandoned``: the progress checker; ``unreachable``: no
+    way through its memory for ``unreachable_timeout``). ``label`` names the method in
     the result (default ``cfg.method``)."""
     sim_cfg = sim_cfg or SimConfig()
     delivery: ScanDelivery[Scan] = ScanDelivery(faults or ScanFaults(),
                                                 sim_cfg.seed + FAULT_SEED_OFFSET)
     cfg = cfg.replace(goal_tolerance=min(cfg.goal_tolerance, world.goal_tolerance))
     ctl = DecisionLoop(cfg, limits)
-    ctl.set_goal(np.asarray(world.goal, float))
+    ctl.set_goal(np.asarray(world.goal, float), in_map=True)   # a place in the world
     path, times, plan_ms, recomputed, statuses = [], [], [], [], {}
     with BurgerSim(world, sim_cfg) as sim:
         while True:
@@ -91,8 +95,8 @@ def run_episode(world: World, cfg: PlannerConfig, sim_cfg: SimConfig | None = No
             path.append(truth)
             times.append(sim.time)
             outcome = outcome_of(world, truth, sim.collided, sim.time, time_limit)
-            if outcome is None and ctl.state is State.STUCK:
-                outcome = Outcome.ABANDONED
+            if outcome is None and ctl.state.gave_up:
+                outcome = GAVE_UP[ctl.state]
             if outcome is not None:
                 break
             now = sim.time

@@ -172,7 +172,7 @@ def _carve(bounds: tuple[float, float, float, float],
             for r0, r1, c0, c1 in _rectangles(occ)]
 
 
-def _solid(lo: float, hi: float, gaps: list[tuple[float, float]]) -> list[tuple[float, float]]:
+def solid(lo: float, hi: float, gaps: list[tuple[float, float]]) -> list[tuple[float, float]]:
     """[lo, hi] minus the ``gaps`` (sorted, disjoint, inside it)."""
     out, at = [], lo
     for a, b in sorted(gaps):
@@ -184,7 +184,7 @@ def _solid(lo: float, hi: float, gaps: list[tuple[float, float]]) -> list[tuple[
     return out
 
 
-def _door(rng: np.random.Generator, lo: float, hi: float, width: tuple[float, float],
+def door(rng: np.random.Generator, lo: float, hi: float, width: tuple[float, float],
           margin: float) -> tuple[float, float]:
     """A door (a, b) of a width drawn in ``width`` on the wall [lo, hi], at least
     ``margin`` from both ends [m]."""
@@ -363,15 +363,15 @@ def _maze(rng: np.random.Generator, r: FamilyRanges) -> Layout:
             line, lo, hi = ('v', i + 1), ys[j], ys[j + 1]
         else:
             line, lo, hi = ('h', j + 1), xs[i], xs[i + 1]
-        doors.setdefault(line, []).append(_door(rng, lo, hi, r.door_width, r.door_margin))
+        doors.setdefault(line, []).append(door(rng, lo, hi, r.door_width, r.door_margin))
         n_doors += 1
     walls = []
     for k in range(1, cols):
         walls += [box(xs[k] - t / 2, a, xs[k] + t / 2, b)
-                  for a, b in _solid(ys[0], ys[-1], doors.get(('v', k), []))]
+                  for a, b in solid(ys[0], ys[-1], doors.get(('v', k), []))]
     for k in range(1, rows):
         walls += [box(a, ys[k] - t / 2, b, ys[k] + t / 2)
-                  for a, b in _solid(xs[0], xs[-1], doors.get(('h', k), []))]
+                  for a, b in solid(xs[0], xs[-1], doors.get(('h', k), []))]
 
     def spot(lo: float, hi: float) -> float:
         return draw(rng, lo + 0.5, hi - 0.5)
@@ -390,7 +390,7 @@ def _long_walk(rng: np.random.Generator, r: FamilyRanges) -> Layout:
     xs = [on_grid(k * total / n + rng.uniform(-0.3, 0.3)) for k in range(1, n)]
     walls = []
     for x in xs:
-        for a, b in _solid(0.0, ly, [_door(rng, 0.0, ly, r.door_width, r.door_margin)]):
+        for a, b in solid(0.0, ly, [door(rng, 0.0, ly, r.door_width, r.door_margin)]):
             walls.append(box(x - t / 2, a, x + t / 2, b))
     start, goal = (end, draw(rng, 0.5, ly - 0.5)), (total - end, draw(rng, 0.5, ly - 0.5))
     return Layout(start, goal, (0.0, 0.0, total, ly), tuple(walls),

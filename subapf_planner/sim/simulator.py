@@ -5,8 +5,9 @@ velocity-controlled from (v, w): slip and acceleration are what PyBullet's
 contact model gives. The lidar is an LDS-01-like 2-D scanner made with
 ``rayTestBatch``: 360 beams from angle 0, 0.12 to 3.5 m, no-return beams as
 +inf, optional Gaussian range noise and dropped beams (also +inf). Odometry
-is the base's motion, optionally with drift; the ground truth is kept apart
-for scoring. The simulator's odom frame is the world frame.
+is the base's motion, optionally with the systematic error of wheel odometry
+(distance and turn-rate scales) and noise; the ground truth is kept apart for
+scoring. The simulator's odom frame is the world frame at the start.
 
 Like the real burger's base, a command older than ``cmd_timeout`` of simulated
 time is replaced by zero velocity (the watchdog).
@@ -70,6 +71,14 @@ class SimConfig:
                                 0.0, 1.0, read_only=True)
     odom_noise: float = param(0.0, 'Relative odometry drift per step', '', 0.0, 1.0,
                               read_only=True)
+    odom_distance_scale: float = param(1.0, 'Odometry reports the distance driven times '
+                                       'this: wheels whose radius is (scale - 1) larger in '
+                                       'the driver than on the robot', '', 0.5, 1.5,
+                                       read_only=True)
+    odom_yaw_scale: float = param(1.0, 'Odometry reports the turn rate times this: '
+                                  '(1 + e_r) / (1 + e_b) for a wheel radius error e_r and '
+                                  'a wheel separation error e_b', '', 0.5, 1.5,
+                                  read_only=True)
     max_linear_velocity: float = param(ROBOT.max_linear_velocity, 'Base speed limit', 'm/s',
                                        0.0, 5.0, read_only=True)
     max_angular_velocity: float = param(ROBOT.max_angular_velocity, 'Base turn-rate limit',
@@ -221,8 +230,17 @@ class BurgerSim:
         return lin[0] * math.cos(yaw) + lin[1] * math.sin(yaw), ang[2]
 
     def _integrate_odom(self) -> None:
+        """Odometry from the base's motion over the last physics step: the body-frame
+        increment (forward, lateral, yaw), scaled by odom_distance_scale (translation)
+        and odom_yaw_scale (rotation), each with relative noise odom_noise, added to the
+        odometry pose. The scales are the systematic error of wheel odometry: a driver
+        that assumes wheels (1 + e_r) times their real radius and a separation (1 + e_b)
+        times the real one reports (1 + e_r) times the distance and (1 + e_r) / (1 + e_b)
+        times the turn (+2 % distance and +3 % turn: e_r = 0.02, e_b = -0.0097)."""
         truth = self.true_pose()
-        if self.config.odom_noise == 0.0:
+        cfg = self.config
+        if cfg.odom_noise == 0.0 and cfg.odom_distance_scale == 1.0 \
+                and cfg.odom_yaw_scale == 1.0:
             self._odom = truth
         else:
             prev = self._truth_prev
@@ -230,8 +248,11 @@ class BurgerSim:
             dx, dy = truth[0] - prev[0], truth[1] - prev[1]
             fwd, lat = c * dx + s * dy, -s * dx + c * dy
             dyaw = math.remainder(truth[2] - prev[2], 2 * math.pi)
-            fwd, lat, dyaw = np.array([fwd, lat, dyaw]) * (
-                1.0 + self.config.odom_noise * self._rng.standard_normal(3))
+            scale = np.array([cfg.odom_distance_scale, cfg.odom_distance_scale,
+                              cfg.odom_yaw_scale])
+            if cfg.odom_noise > 0.0:
+                scale = scale * (1.0 + cfg.odom_noise * self._rng.standard_normal(3))
+            fwd, lat, dyaw = np.array([fwd, lat, dyaw]) * scale
             oc, os_ = math.cos(self._odom[2]), math.sin(self._odom[2])
             self._odom = self._odom + [oc * fwd - os_ * lat, os_ * fwd + oc * lat, dyaw]
             self._odom[2] = math.remainder(self._odom[2], 2 * math.pi)

@@ -22,7 +22,8 @@ is BASE_TIME + TIME_FACTOR x geodesic length / MAX_SPEED [s], the geodesic being
 the shortest 8-connected path through the free cells (at most 8 % longer than
 the true shortest path).
 
-The dynamic families (sim/dynamic_families.py) are checked the same way on their
+The building family (sim/building.py) is a suite of its own (``--families
+building``). The dynamic families (sim/dynamic_families.py) are checked the same way on their
 static obstacles (moving ones are not walls: they pass); in addition no moving
 obstacle may come within START_MARGIN m of the start's footprint in the first
 START_GRACE s, and its paths go through the same symmetry and shift.
@@ -39,17 +40,19 @@ import zlib
 
 import numpy as np
 
+from .building import BUILDING_BUILDERS, BUILDING_FAMILIES, BUILDING_RANGES
 from .dynamic_families import DYNAMIC_BUILDERS, DYNAMIC_FAMILIES, DYNAMIC_RANGES
 from .families import BUILDERS, FAMILIES, RANGES, FamilyRanges, Layout, circle
 from .solvability import geodesic_length
 from .world import FOOTPRINT_RADIUS, World, WorldError, parse_world
 
-__all__ = ['ALL_FAMILIES', 'DYNAMIC_FAMILIES', 'FAMILIES', 'RANGES', 'FamilyRanges',
-           'GeneratedWorld', 'generate', 'generate_world', 'sub_seed', 'suite',
+__all__ = ['ALL_FAMILIES', 'BUILDING_FAMILIES', 'DYNAMIC_FAMILIES', 'FAMILIES', 'RANGES',
+           'FamilyRanges', 'GeneratedWorld', 'generate', 'generate_world', 'sub_seed', 'suite',
            'suite_worlds', 'time_limit']
 
-#: Every family: the static ones of the dev suite (the default), then the dynamic ones.
-ALL_FAMILIES = FAMILIES + DYNAMIC_FAMILIES
+#: Every family: the static ones of the dev suite (the default), the dynamic ones, the
+#: building floors (a suite of their own).
+ALL_FAMILIES = FAMILIES + DYNAMIC_FAMILIES + BUILDING_FAMILIES
 #: No moving obstacle within this gap of the start's footprint [m] ...
 START_MARGIN = 0.5
 #: ... during the first seconds of the run [s].
@@ -158,9 +161,18 @@ def _family_key(family: str) -> int:
 
 
 def _check_family(family: str) -> None:
-    if family not in BUILDERS and family not in DYNAMIC_BUILDERS:
+    if family not in ALL_FAMILIES:
         raise ValueError(f'unknown world family {family!r}; choose from '
                          f'{", ".join(ALL_FAMILIES)}')
+
+
+def _layout(family: str, rng: np.random.Generator, ranges: FamilyRanges) -> Layout:
+    """One draw of ``family`` (``ranges``: those of the static families)."""
+    if family in BUILDERS:
+        return BUILDERS[family](rng, ranges)
+    if family in DYNAMIC_BUILDERS:
+        return DYNAMIC_BUILDERS[family](rng, DYNAMIC_RANGES)
+    return BUILDING_BUILDERS[family](rng, BUILDING_RANGES)
 
 
 def time_limit(geodesic: float) -> int:
@@ -183,8 +195,7 @@ def generate_world(family: str, seed: int, name: str | None = None,
     for attempt in range(MAX_ATTEMPTS):
         rng = np.random.default_rng(np.random.SeedSequence([int(seed), _family_key(family),
                                                             attempt]))
-        layout = BUILDERS[family](rng, ranges) if family in BUILDERS \
-            else DYNAMIC_BUILDERS[family](rng, DYNAMIC_RANGES)
+        layout = _layout(family, rng, ranges)
         doc = _document(layout, rng, name)
         try:
             world = parse_world(doc, name)

@@ -111,13 +111,13 @@ def family_of(world: str) -> str:
 
 def by_family(runs: list[dict], methods: list[str]) -> str:
     """Per family and method: reached, collisions (hit while stopped), timeouts,
-    abandoned, median time of the reached runs and least clearance; '' for a single
+    abandoned, unreachable, median time of the reached runs and least clearance; '' for a single
     family."""
     families = sorted({family_of(r['world']) for r in runs})
     if len(families) < 2:
         return ''
-    lines = ['| family | method | reached | collisions | timeouts | abandoned '
-             '| median time [s] | min clearance [m] |', '|' + '---|' * 8]
+    lines = ['| family | method | reached | collisions | timeouts | abandoned | unreachable '
+             '| median time [s] | min clearance [m] |', '|' + '---|' * 9]
     for fam in families:
         for m in methods:
             rs = [r for r in runs if r['method'] == m and family_of(r['world']) == fam]
@@ -128,6 +128,7 @@ def by_family(runs: list[dict], methods: list[str]) -> str:
                 f'| {fam} | {m} | {len(ok)}/{len(rs)} | {_collisions(rs)} '
                 f'| {sum(r["outcome"] == "timeout" for r in rs)} '
                 f'| {sum(r["outcome"] == "abandoned" for r in rs)} '
+                f'| {sum(r["outcome"] == "unreachable" for r in rs)} '
                 f'| {f"{statistics.median(ok):.1f}" if ok else "-"} '
                 f'| {min(r["min_clearance"] for r in rs):.3f} |')
     return '\n'.join(lines) + '\n'
@@ -135,9 +136,9 @@ def by_family(runs: list[dict], methods: list[str]) -> str:
 
 def summarise(runs: list[dict], methods: list[str]) -> str:
     """Markdown table per method, then an outcome matrix method x world."""
-    lines = ['| method | runs | reached | collisions | timeouts | abandoned | median time [s] '
-             '| median path [m] | min clearance [m] | median curvature [1/m] '
-             '| plan ms (median) |', '|' + '---|' * 11]
+    lines = ['| method | runs | reached | collisions | timeouts | abandoned | unreachable '
+             '| median time [s] | median path [m] | min clearance [m] '
+             '| median curvature [1/m] | plan ms (median) |', '|' + '---|' * 12]
     for m in methods:
         rs = [r for r in runs if r['method'] == m]
         if not rs:
@@ -150,7 +151,8 @@ def summarise(runs: list[dict], methods: list[str]) -> str:
             f'| {m} | {len(rs)} | {len(ok)}/{len(rs)} '
             f'| {_collisions(rs)} '
             f'| {sum(r["outcome"] == "timeout" for r in rs)} '
-            f'| {sum(r["outcome"] == "abandoned" for r in rs)} | {med("time_s")} '
+            f'| {sum(r["outcome"] == "abandoned" for r in rs)} '
+            f'| {sum(r["outcome"] == "unreachable" for r in rs)} | {med("time_s")} '
             f'| {med("path_length")} | {min(r["min_clearance"] for r in rs):.3f} '
             f'| {med("mean_abs_curvature")} | {med("plan_ms_median", rs)} |')
     worlds = sorted({r['world'] for r in runs})
@@ -179,6 +181,10 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
     p.add_argument('--noise', type=float, default=0.01,
                    help='laser range noise sigma [m] (Gazebo TurtleBot3: 0.01)')
     p.add_argument('--beam-dropout', type=float, default=0.0, help='fraction of dropped beams')
+    p.add_argument('--odom-scale', type=float, default=1.0,
+                   help='odometry distance scale (1.02: reports 2 %% too far)')
+    p.add_argument('--odom-yaw-scale', type=float, default=1.0,
+                   help='odometry turn-rate scale (1.03: reports 3 %% too much turn)')
     p.add_argument('--scan-dropout', type=float, default=0.0,
                    help='probability that a scan never reaches the planner')
     p.add_argument('--scan-latency', type=float, default=0.0,
@@ -199,7 +205,9 @@ def main(argv: list[str] | None = None) -> int:
             parse_method(m)
         cfg = load_config(args.params or default_params_file())
         sim_cfg = SimConfig(seed=args.seed, range_noise=args.noise,
-                            beam_dropout=args.beam_dropout)
+                            beam_dropout=args.beam_dropout,
+                            odom_distance_scale=args.odom_scale,
+                            odom_yaw_scale=args.odom_yaw_scale)
         faults = ScanFaults(args.scan_dropout, args.scan_latency)
         files = world_files(args.worlds or [shipped_worlds_dir()])
         worlds = {str(f): load_world(f) for f in files}
@@ -222,7 +230,8 @@ def main(argv: list[str] | None = None) -> int:
     labels = list(dict.fromkeys(r['method'] for r in runs))
     doc = {'runs': runs, 'methods': labels, 'seed': args.seed, 'noise': args.noise,
            'beam_dropout': args.beam_dropout, 'scan_dropout': args.scan_dropout,
-           'scan_latency': args.scan_latency, 'wall_time_s': round(wall, 2),
+           'scan_latency': args.scan_latency, 'odom_distance_scale': args.odom_scale,
+           'odom_yaw_scale': args.odom_yaw_scale, 'wall_time_s': round(wall, 2),
            'params': dataclasses.asdict(cfg)}
     (out / 'results.json').write_text(json.dumps(doc, indent=1))
     (out / 'summary.md').write_text(summarise(runs, labels) + '\n' + by_family(runs, labels)

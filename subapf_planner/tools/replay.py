@@ -75,7 +75,8 @@ def main(argv: list[str] | None = None) -> int:
             comparison = replay_through_node(args.bag, str(params), names, args.method, domain)
         else:
             comparison = replay(args.bag, cfg, limits, names,
-                                Intake(options.laser_frame, options.odom_frame))
+                                Intake(options.laser_frame, options.odom_frame,
+                                       options.map_frame))
     except (BagError, ConfigError) as exc:
         print(f'subapf-replay: {exc}', file=sys.stderr)
         return 2
