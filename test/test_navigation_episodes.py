@@ -67,3 +67,26 @@ def test_a_gap_of_twice_robot_radius_plus_5_cm_is_passed(offset):
     world = parse_world(doc)
     assert run_episode(world, PlannerConfig()).outcome is Outcome.REACHED
     assert run_episode(world, PAPER).outcome is not Outcome.REACHED
+
+
+def test_a_gap_it_cannot_pass_is_marked_tried_and_the_other_way_taken():
+    """A 0.25 m gap straight ahead: the field (inflated by the footprint, 0.21 m) leads
+    through it, as the way round the wall's open end is 8 m longer; the local layer
+    (samples kept 0.135 m from laser points) cannot pass, and the robot stands with
+    no_safe_move. Without recoveries the progress checker abandons the goal; with them
+    the gap is marked tried, the field leads round the wall's end, and the goal is
+    reached."""
+    gap, end = 0.25, 5.5
+    doc = {'name': 'narrow', 'start': [0.0, 0.0, 1.5708], 'goal': [0.0, 3.0],
+           'time_limit': 200, 'bounds': [-2.5, -1.0, end + 2.5, 4.0],
+           'obstacles': [{'box': {'center': [(-gap / 2 - 2.5) / 2, 1.5],
+                                  'size': [2.5 - gap / 2, 0.1]}},
+                         {'box': {'center': [(gap / 2 + end) / 2, 1.5],
+                                  'size': [end - gap / 2, 0.1]}}]}
+    world = parse_world(doc)
+    given_up = run_episode(world, PlannerConfig(), limits=Supervision(recoveries=0))
+    assert given_up.outcome is Outcome.ABANDONED
+    assert given_up.statuses.get('no_safe_move', 0) > 10
+    result = run_episode(world, PlannerConfig())
+    assert result.outcome is Outcome.REACHED
+    assert result.path[:, 0].max() > end            # round the wall's end, not the gap

@@ -150,12 +150,28 @@ def test_goal_reached_gives_zero_velocity(harness):
 
 def test_goal_in_another_frame_is_refused(harness):
     h = harness()
-    h.goal(2.0, 0.0, frame='map')
+    h.goal(2.0, 0.0, frame='base_link')
     # three ticks with fresh inputs after the refused goal: still idle, no command
     assert h.spin_until(lambda: (h.feed(), h.states.count('idle: no goal') >= 3)[1])
     assert h.node.ctl.goal is None and h.cmds == []
     h.goal(2.0, 0.0)   # the same goal in odom is taken
     assert h.spin_until(lambda: (h.feed(), any(c.twist.linear.x > 0 for c in h.cmds))[1])
+    assert not h.node.ctl.goal_in_map
+
+
+def test_goal_in_the_map_frame_is_taken_and_the_correction_published(harness):
+    from geometry_msgs.msg import TransformStamped
+    h = harness()
+    corrections = []
+    h.peer.create_subscription(TransformStamped, '/subapf_planner/correction',
+                               corrections.append, 10)
+    h.goal(2.0, 0.0, frame='map')
+    assert h.spin_until(lambda: (h.feed(), any(c.twist.linear.x > 0 for c in h.cmds)
+                                 and bool(corrections))[1])
+    assert h.node.ctl.goal_in_map
+    c = corrections[-1]
+    assert (c.header.frame_id, c.child_frame_id) == ('map', 'odom')
+    assert c.transform.rotation.w == pytest.approx(1.0)   # a still robot: no correction
 
 
 def test_twist_when_stamped_disabled(harness):

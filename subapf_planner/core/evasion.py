@@ -14,10 +14,11 @@ its first EVASION_COMMIT seconds keep ``robot_radius + STATIC_MARGIN`` from
 every laser point that is not a moving track's, and the safety corridor does
 not block its forward speed. Among the admissible ones that keep the clearance,
 the one closest to the planned command wins (the robot steps aside rather than
-turns back); when none keeps it, the one with the largest gap (it never stands
-still in an obstacle's way while a way out exists). Time-weighted so that a
-meeting soon counts more than one later. The chosen manoeuvre is committed: the
-next cycle considers it again, one period on.
+turns back); when none keeps it, one that never touches a predicted disc within
+the horizon, else the one that touches latest, and among those the largest gap
+(it never stands still in an obstacle's way while a way out exists). Gaps are
+time-weighted so that a meeting soon counts more than one later. The chosen
+manoeuvre is committed: the next cycle considers it again, one period on.
 """
 
 from __future__ import annotations
@@ -92,25 +93,46 @@ def rollout(pose: NDArray[np.float64], v: float, w: float, horizon: float) -> ND
     return rollouts(pose, np.array([v]), np.full((1, _steps(horizon)), w))[0]
 
 
+def _gaps(paths: NDArray[np.float64], tracks: Tracks,
+          robot_radius: float) -> NDArray[np.float64]:
+    """Gap [m] (c, k) at each rollout step between the footprint along each of the paths
+    (c, k, 2) (one point per ROLLOUT_DT from one step ahead) and the nearest moving
+    track's predicted disc; inf with none."""
+    m = tracks.moving
+    if not np.any(m):
+        return np.full(paths.shape[:2], math.inf)
+    t = (np.arange(paths.shape[1]) + 1)[:, None] * ROLLOUT_DT                 # (k, 1)
+    where = tracks.position[m][None] + t[..., None] * tracks.velocity[m][None]   # (k, n, 2)
+    d = paths[:, :, None, :] - where[None]                                      # (c, k, n, 2)
+    gap = np.hypot(d[..., 0], d[..., 1]) - tracks.radius[m] - robot_radius
+    return gap.min(axis=2)
+
+
+def _discounted(gaps: NDArray[np.float64]) -> NDArray[np.float64]:
+    """The smallest time-discounted gap of each rollout (c,) [m]."""
+    t = (np.arange(gaps.shape[1]) + 1) * ROLLOUT_DT
+    return (gaps + TIME_DISCOUNT * t).min(axis=1)
+
+
 def moving_gaps(paths: NDArray[np.float64], tracks: Tracks,
                 robot_radius: float) -> NDArray[np.float64]:
     """Smallest time-discounted gap [m] (c,) between the footprint along each of the
     paths (c, k, 2) (one point per ROLLOUT_DT from one step ahead) and the moving tracks'
     predicted discs; inf with none."""
-    m = tracks.moving
-    if not np.any(m):
-        return np.full(len(paths), math.inf)
-    t = (np.arange(paths.shape[1]) + 1)[:, None] * ROLLOUT_DT                 # (k, 1)
-    where = tracks.position[m][None] + t[..., None] * tracks.velocity[m][None]   # (k, n, 2)
-    d = paths[:, :, None, :] - where[None]                                      # (c, k, n, 2)
-    gap = np.hypot(d[..., 0], d[..., 1]) - tracks.radius[m] - robot_radius \
-        + TIME_DISCOUNT * t
-    return gap.min(axis=(1, 2))
+    return _discounted(_gaps(paths, tracks, robot_radius))
 
 
 def moving_gap(path: NDArray[np.float64], tracks: Tracks, robot_radius: float) -> float:
     """:func:`moving_gaps` of one path (k, 2)."""
     return float(moving_gaps(path[None], tracks, robot_radius)[0])
+
+
+def contact_time(gaps: NDArray[np.float64]) -> NDArray[np.float64]:
+    """When each rollout (c, k gaps) first touches a track's predicted disc [s]; inf for
+    one that never does within the horizon."""
+    touch = gaps < 0.0
+    first = np.argmax(touch, axis=1)
+    return np.where(touch.any(axis=1), (first + 1) * ROLLOUT_DT, math.inf)
 
 
 def _static_clear(paths: NDArray, static: NDArray, radius: float) -> NDArray[np.bool_]:
@@ -164,7 +186,9 @@ def evade(pose: NDArray[np.float64], planned: tuple[float, float], tracks: Track
     ok &= (v == 0.0) | _static_clear(paths, static, cfg.robot_radius)
     if not np.any(ok):
         return None
-    gap = np.where(ok, moving_gaps(paths, tracks, cfg.robot_radius), -math.inf)
+    gaps = _gaps(paths, tracks, cfg.robot_radius)
+    gap = np.where(ok, _discounted(gaps), -math.inf)
+    touch = np.where(ok, contact_time(gaps), -math.inf)
     kept = np.zeros(len(options), bool)
     if committed is not None and options[-1] is committed:
         kept[-1] = ok[-1]
@@ -173,9 +197,10 @@ def evade(pose: NDArray[np.float64], planned: tuple[float, float], tracks: Track
         # the committed escape, else the one closest to the plan (then the larger gap)
         near = np.abs(v - v0) + 0.1 * np.abs(turn[:, 0] - w0)
         score = np.where(kept, -1.0, near)
-        best = int(np.lexsort((-gap, np.where(safe, score, math.inf)))[0])
-    else:
-        best = int(np.argmax(gap))
-        if kept[-1] and gap[-1] >= gap[best] - HYSTERESIS:
-            best = len(options) - 1
+        return options[int(np.lexsort((-gap, np.where(safe, score, math.inf)))[0])]
+    # none keeps the clearance: one that never touches, else the latest touch; then the
+    # largest gap (the committed one while within HYSTERESIS of it)
+    best = int(np.lexsort((-gap, -touch))[0])
+    if kept[-1] and touch[-1] >= touch[best] and gap[-1] >= gap[best] - HYSTERESIS:
+        best = len(options) - 1
     return options[best]
