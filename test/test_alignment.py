@@ -59,13 +59,13 @@ def match(grid, base, predicted):
 
 @pytest.mark.core
 def test_a_known_offset_is_recovered():
-    """The prediction 1.5 cm, 1 cm and 0.5 degrees off (drift builds up about a
-    millimetre per scan; the deadband lets it reach a centimetre): the match is within
-    8 mm and 0.1 degrees of the true pose (the prior holds back a few mm)."""
+    """The prediction 2.5 cm, 1.5 cm and 0.7 degrees off (drift builds up about a
+    millimetre per scan; the deadband lets it reach 1.5 cm and 0.6 degrees): the match
+    is within 8 mm and 0.1 degrees of the true pose (the prior holds back a few mm)."""
     walls = room()
     true = np.array([0.4, -0.3, 0.2])
     base = seen_from(walls, true)
-    m = match(grid_with(walls), base, true + [0.015, -0.01, 0.009])
+    m = match(grid_with(walls), base, true + [0.025, -0.015, 0.012])
     assert m.accepted and m.matched > 200 and m.rms < 0.03
     assert np.hypot(*(m.pose[:2] - true[:2])) < 0.008
     assert abs(m.pose[2] - true[2]) < math.radians(0.1)
@@ -80,7 +80,7 @@ def test_a_corridor_is_corrected_across_and_left_alone_along():
                        segment((-6.0, 0.625), (6.0, 0.625))])
     true = np.array([0.0, 0.1, 0.0])
     base = seen_from(walls, true)
-    m = match(grid_with(walls), base, true + [0.015, 0.012, 0.008])
+    m = match(grid_with(walls), base, true + [0.015, 0.02, 0.008])
     assert m.accepted
     assert abs(m.pose[1] - true[1]) < 0.004 and abs(m.pose[2] - true[2]) < 0.002
     assert m.pose[0] - true[0] == pytest.approx(0.015, abs=0.003)
@@ -95,7 +95,7 @@ def test_no_map_few_returns_or_a_jump_are_refused_and_agreement_leaves_the_pose(
     assert not match(empty, base, true).accepted                       # nothing to match
     m = match(grid_with(walls), base[:10], true)                        # too few returns
     assert not m.accepted and np.array_equal(m.pose, true)
-    far = true + [MAX_STEP_XY + 0.01, 0.0, 0.0]                        # a jump: refused,
+    far = true + [MAX_STEP_XY + 0.03, 0.0, 0.0]                        # a jump: refused,
     m = match(grid_with(walls), base, far)                              # the prediction
     assert not m.accepted and np.array_equal(m.pose, far)               # stands
     near = true + [0.004, -0.003, 0.002]                                # within the deadband:

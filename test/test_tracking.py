@@ -182,29 +182,3 @@ def test_escape_command_is_its_first_step():
     assert Escape(0.1, (0.5, 0.0)).command == (0.1, 0.5)
     assert Escape(0.1, (0.5, 0.0)).advanced() == Escape(0.1, (0.0, 0.0))
 
-
-def test_a_walker_along_a_mapped_wall_is_its_own_cluster_and_new_ones_move_sooner():
-    """Someone walking 5 cm from a wall that the memory already holds: the wall's points
-    (on established cells) are not clustered, so the walker is tracked alone. Appearing
-    in seen-free space, it is a mover after 0.15 m (NEW_MOVE_DISTANCE); the same walk
-    over unknown cells needs 0.3 m."""
-    v = np.array([0.0, 0.2])
-    wall = np.column_stack((np.full(60, 1.3), np.linspace(-1.5, 1.5, 60)))
-
-    def moving_from(free_log_odds):
-        tr = Tracker(0.15, 1.2, 0.6, 0.04)
-        for k in range(12):
-            walker = disc_points(np.array([1.0, -0.6]) + v * 0.2 * k, 0.25)
-            pts = np.vstack([walker, wall])
-            lo = np.concatenate([np.full(len(walker), free_log_odds), np.full(len(wall), 3.5)])
-            tracks = tr.update(pts, 0.2 * k, lo)
-            assert (tracks.point_track[len(walker):] == -1).all()   # the wall: no track
-            if tracks.moving.any():
-                assert tracks.moving_points[:len(walker)].all()
-                return k
-        return None
-    new, unknown = moving_from(-1.0), moving_from(0.0)
-    assert new is not None and unknown is not None
-    walked = 0.2 * 0.2   # [m] per scan
-    assert walked * new >= 0.15 - 1e-9 and new < unknown
-    assert walked * unknown >= 0.3 - 1e-9

@@ -1,14 +1,15 @@
 """Scan alignment: each scan matched to the occupancy memory before it is written,
 so that drifting wheel odometry does not draw a wall twice.
 
-The map side is a distance field: the distance [m] from every cell of a window
-around the scan to the nearest *established* obstacle cell (log odds at least
-ESTABLISHED, three hits or more: what the memory is sure of), by scipy's exact
-Euclidean distance transform. The scan side is its returns in base_footprint.
-The pose (x, y, yaw) of base_footprint that puts the returns on the walls is
-found by Gauss-Newton on the squared distances (the likelihood-field matcher
-of Thrun, Burgard and Fox, "Probabilistic Robotics", ch. 6.4, in its
-least-squares form, as Hector SLAM's), bilinear on the field, with
+The map side is a distance field: for every cell of a window around the scan,
+the nearest *established* obstacle cell (log odds at least ESTABLISHED, three
+hits or more: what the memory is sure of; scipy's exact Euclidean distance
+transform) and the wall's normal there (the structure tensor of the blurred
+wall mask). The scan side is its returns in base_footprint. The pose (x, y,
+yaw) of base_footprint that puts the returns on the walls is found by
+Gauss-Newton on the squared residuals (the likelihood-field matcher of Thrun,
+Burgard and Fox, "Probabilistic Robotics", ch. 6.4, in its least-squares form,
+as Hector SLAM's, with point-to-line residuals as in ICP), where
 
 * the residual of a return is its distance to the nearest wall point along the
   wall's normal there (point-to-line: the end of a wall does not pull the pose
@@ -60,10 +61,10 @@ RETURN_SIGMA = 0.03
 #: A match that moves the prediction less than this (both) leaves it [m], [rad]: the
 #: matcher's own error (a map built as it goes) does not walk the pose, while drift,
 #: which grows, is corrected once it is this large.
-DEADBAND_XY = 0.01
-DEADBAND_YAW = 0.005
+DEADBAND_XY = 0.015
+DEADBAND_YAW = 0.01
 #: A match that moves the prediction more than this is refused [m], [rad].
-MAX_STEP_XY = 0.02
+MAX_STEP_XY = 0.03
 MAX_STEP_YAW = 0.03
 
 

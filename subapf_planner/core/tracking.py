@@ -3,10 +3,9 @@ Kalman filters; which points move.
 
 Each scan's obstacle points (odom, in beam order) are cut into clusters where
 two neighbours are ``cluster_gap`` or more apart (laser scan segmentation); a
-cluster longer than ``max_mover_size`` or straight (a piece of wall seen at a
-grazing angle) is a wall and is never tracked, and so are the points on the
-memory's established obstacles (they are not clustered at all, so a person next
-to a wall or a post stays a cluster of their own). The others are
+cluster longer than ``max_mover_size``, straight (a piece of wall seen at a
+grazing angle), or standing mostly on the memory's established obstacles, is a
+wall and is never tracked. The others are
 associated with the tracks predicted to this scan's time (Hungarian assignment,
 scipy, within ``track_gate``) and update their filter; unmatched clusters start
 tentative tracks, and a track unseen for MAX_MISSES scans is dropped.
@@ -19,9 +18,8 @@ operations for every track at once; filterpy's per-object KalmanFilter costs a
 Python object per track per step for the same equations.
 
 A track **moves** when it has been seen MIN_HITS times, its estimated speed is
-at least ``moving_speed``, and it has been MOVE_DISTANCE (NEW_MOVE_DISTANCE
-for one new in seen-free space) from where it was first seen at some time
-(someone walking to and fro stays a mover). It is
+at least ``moving_speed``, and it has been MOVE_DISTANCE from where it was
+first seen at some time (someone walking to and fro stays a mover). It is
 **held** out of the occupancy memory while it moves, and while its cluster is new
 and stands mostly on cells the memory has seen free (something new where there
 was nothing: held NEW_OBJECT_SCANS scans, then written if it did not move).
@@ -50,11 +48,8 @@ MIN_HITS = 3
 #: A new object in seen-free space is held out of the memory this many scans.
 NEW_OBJECT_SCANS = 15
 #: A track moves only once it is this far from where it was first seen [m]: the centroid
-#: of a static object's visible side wanders less as the robot drives past it ...
+#: of a static object's visible side wanders less as the robot drives past it.
 MOVE_DISTANCE = 0.3
-#: ... or this far for one that is new in seen-free space (something that was not there:
-#: a person stepping out from behind a corner is a mover before it has walked far).
-NEW_MOVE_DISTANCE = 0.15
 #: A cluster whose points lie this close to a line [m] (the smaller principal standard
 #: deviation), and that is longer than THIN_LENGTH [m], is a piece of wall: a wall seen
 #: at a grazing angle breaks into short straight pieces whose centroids slide along
@@ -73,10 +68,11 @@ TRAIL_SCANS = 12
 FREE_LOG_ODDS = -0.5
 #: Fraction of a cluster's points on seen-free cells that makes it new.
 NEW_FRACTION = 0.5
-#: Log odds from which a cell is an established obstacle (three hits or more): points on
-#: such cells are part of the map (a wall whose visible part changes as the robot
-#: drives), never a mover's.
+#: Log odds from which a cell is an established obstacle (three hits or more) ...
 WALL_LOG_ODDS = 2.0
+#: ... and the fraction of a cluster's points on such cells that makes it part of the
+#: map: a piece of wall whose visible part changes as the robot drives, not a mover.
+WALL_FRACTION = 0.5
 
 
 @dataclass(frozen=True)
@@ -206,14 +202,10 @@ class Tracker:
         self.time = t
         if dt > 0.0 and len(self.x):
             self._predict(dt)
-        # points on the map's established obstacles are walls: the rest is segmented, so
-        # that someone walking along a wall or past a post is a cluster of their own
-        loose = np.flatnonzero(log_odds_at < WALL_LOG_ODDS)
-        labels, count = clusters(points[loose], self.gap)
-        cents, sizes, new, thin = _cluster_features(points[loose], labels, count,
-                                                    log_odds_at[loose])
-        # walls (long, straight or a few points) are not tracked
-        small = np.flatnonzero((sizes <= self.max_size) & ~thin)
+        labels, count = clusters(points, self.gap)
+        cents, sizes, new, mapped, thin = _cluster_features(points, labels, count, log_odds_at)
+        # walls (long, or standing on the map's established obstacles) are not tracked
+        small = np.flatnonzero((sizes <= self.max_size) & (mapped < WALL_FRACTION) & ~thin)
         small = small[np.argsort(-sizes[small], kind='stable')][:MAX_CLUSTERS]
         track_of = np.full(count, -1, np.int64)
         n_tracks = len(self.x)
@@ -251,13 +243,10 @@ class Tracker:
         self.radius[track_of[visible]] = 0.5 * sizes[visible]
         speed = np.hypot(self.x[:, 2], self.x[:, 3])
         self.went = np.maximum(self.went, np.hypot(*(self.x[:, :2] - self.first).T))
-        new_now = (self.new_age >= 0) & (self.new_age < NEW_OBJECT_SCANS)
         moving = (self.hits >= MIN_HITS) & (speed >= self.moving_speed) \
-            & (self.went >= np.where(new_now, NEW_MOVE_DISTANCE, MOVE_DISTANCE))
-        held = moving | new_now
-        point_track = np.full(len(points), -1, np.int64)
-        if count:
-            point_track[loose] = track_of[labels]
+            & (self.went >= MOVE_DISTANCE)
+        held = moving | ((self.new_age >= 0) & (self.new_age < NEW_OBJECT_SCANS))
+        point_track = track_of[labels] if count else np.zeros(0, np.int64)
         trail = [pts[np.isin(ids, self.ids[held])] for ids, pts in self._history] \
             if np.any(held) else []
         self._history = (self._history + [(np.where(point_track >= 0, self.ids[
@@ -271,8 +260,8 @@ class Tracker:
 def _cluster_features(points: NDArray[np.float64], labels: NDArray[np.int64], count: int,
                       log_odds_at: NDArray[np.float64]) -> tuple[NDArray, ...]:
     """Per cluster: centroid (k, 2), extent (bounding-box diagonal, k) [m], fraction of
-    its points on seen-free cells (k,), and whether it is a straight piece or too few
-    points to track (k,; THIN_STD, THIN_LENGTH, MIN_POINTS)."""
+    its points on seen-free cells and on established obstacles (k,), and whether it is a
+    straight piece or too few points to track (k,; THIN_STD, THIN_LENGTH, MIN_POINTS)."""
     n = np.bincount(labels, minlength=count).astype(float)
     cents = np.column_stack([np.bincount(labels, points[:, i], count) for i in (0, 1)]) \
         / n[:, None]
@@ -282,10 +271,11 @@ def _cluster_features(points: NDArray[np.float64], labels: NDArray[np.int64], co
     np.maximum.at(hi, labels, points)
     sizes = np.hypot(*(hi - lo).T)
     new = np.bincount(labels, log_odds_at < FREE_LOG_ODDS, count) / n
+    mapped = np.bincount(labels, log_odds_at >= WALL_LOG_ODDS, count) / n
     d = points - cents[labels]
     sxx, syy, sxy = (np.bincount(labels, a * b, count) / n
                      for a, b in ((d[:, 0], d[:, 0]), (d[:, 1], d[:, 1]), (d[:, 0], d[:, 1])))
     smallest = 0.5 * (sxx + syy) - np.sqrt(0.25 * (sxx - syy) ** 2 + sxy ** 2)
     thin = ((np.sqrt(np.maximum(smallest, 0.0)) < THIN_STD) & (sizes > THIN_LENGTH)) \
         | (n < MIN_POINTS)
-    return cents, sizes, new, thin
+    return cents, sizes, new, mapped, thin
