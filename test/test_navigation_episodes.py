@@ -90,3 +90,16 @@ def test_a_gap_it_cannot_pass_is_marked_tried_and_the_other_way_taken():
     result = run_episode(world, PlannerConfig())
     assert result.outcome is Outcome.REACHED
     assert result.path[:, 0].max() > end            # round the wall's end, not the gap
+
+
+def test_a_robot_that_stops_believing_it_is_there_has_missed():
+    """Odometry 30 % long in an empty room (nothing for the scan alignment to hold on
+    to): the planner stops at the goal by its estimate, 0.7 of the way there in truth.
+    The run ends at once as `missed` (not a timeout), the truth's distance recorded."""
+    from subapf_planner.sim.simulator import SimConfig
+    doc = {'name': 'open', 'start': [0.0, 0.0, 0.0], 'goal': [3.0, 0.0], 'time_limit': 120,
+           'obstacles': []}
+    result = run_episode(parse_world(doc), PlannerConfig(), SimConfig(odom_distance_scale=1.3))
+    assert result.outcome is Outcome.MISSED
+    assert result.final_distance == pytest.approx(3.0 - 3.0 / 1.3, abs=0.2)
+    assert result.time_s < 60.0

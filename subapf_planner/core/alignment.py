@@ -53,8 +53,8 @@ CONVERGED = 5e-4
 #: Blur of the wall mask whose structure gives the walls' normals [cells].
 NORMAL_SIGMA = 1.0
 #: Prior standard deviation of the prediction, per scan [m], [rad].
-PRIOR_SIGMA_XY = 0.005
-PRIOR_SIGMA_YAW = 0.01
+PRIOR_SIGMA_XY = 0.02
+PRIOR_SIGMA_YAW = 0.02
 #: Standard deviation of one return's distance to the wall [m] (the laser's noise plus
 #: half a cell).
 RETURN_SIGMA = 0.03

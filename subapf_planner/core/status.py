@@ -70,3 +70,6 @@ class Outcome(StrEnum):
     #: The planner ended the attempt: no way to the goal through its memory for
     #: ``unreachable_timeout``.
     UNREACHABLE = 'unreachable'
+    #: The planner stopped at the goal by its own (odometry, aligned) estimate, but the
+    #: robot really stands outside the goal's tolerance: the localisation was off.
+    MISSED = 'missed'

@@ -111,13 +111,13 @@ def family_of(world: str) -> str:
 
 def by_family(runs: list[dict], methods: list[str]) -> str:
     """Per family and method: reached, collisions (hit while stopped), timeouts,
-    abandoned, unreachable, median time of the reached runs and least clearance; '' for a single
-    family."""
+    abandoned, unreachable, missed, median time of the reached runs and least
+    clearance; '' for a single family."""
     families = sorted({family_of(r['world']) for r in runs})
     if len(families) < 2:
         return ''
     lines = ['| family | method | reached | collisions | timeouts | abandoned | unreachable '
-             '| median time [s] | min clearance [m] |', '|' + '---|' * 9]
+             '| missed | median time [s] | min clearance [m] |', '|' + '---|' * 10]
     for fam in families:
         for m in methods:
             rs = [r for r in runs if r['method'] == m and family_of(r['world']) == fam]
@@ -129,6 +129,7 @@ def by_family(runs: list[dict], methods: list[str]) -> str:
                 f'| {sum(r["outcome"] == "timeout" for r in rs)} '
                 f'| {sum(r["outcome"] == "abandoned" for r in rs)} '
                 f'| {sum(r["outcome"] == "unreachable" for r in rs)} '
+                f'| {sum(r["outcome"] == "missed" for r in rs)} '
                 f'| {f"{statistics.median(ok):.1f}" if ok else "-"} '
                 f'| {min(r["min_clearance"] for r in rs):.3f} |')
     return '\n'.join(lines) + '\n'
@@ -137,8 +138,8 @@ def by_family(runs: list[dict], methods: list[str]) -> str:
 def summarise(runs: list[dict], methods: list[str]) -> str:
     """Markdown table per method, then an outcome matrix method x world."""
     lines = ['| method | runs | reached | collisions | timeouts | abandoned | unreachable '
-             '| median time [s] | median path [m] | min clearance [m] '
-             '| median curvature [1/m] | plan ms (median) |', '|' + '---|' * 12]
+             '| missed | median time [s] | median path [m] | min clearance [m] '
+             '| median curvature [1/m] | plan ms (median) |', '|' + '---|' * 13]
     for m in methods:
         rs = [r for r in runs if r['method'] == m]
         if not rs:
@@ -152,7 +153,8 @@ def summarise(runs: list[dict], methods: list[str]) -> str:
             f'| {_collisions(rs)} '
             f'| {sum(r["outcome"] == "timeout" for r in rs)} '
             f'| {sum(r["outcome"] == "abandoned" for r in rs)} '
-            f'| {sum(r["outcome"] == "unreachable" for r in rs)} | {med("time_s")} '
+            f'| {sum(r["outcome"] == "unreachable" for r in rs)} '
+            f'| {sum(r["outcome"] == "missed" for r in rs)} | {med("time_s")} '
             f'| {med("path_length")} | {min(r["min_clearance"] for r in rs):.3f} '
             f'| {med("mean_abs_curvature")} | {med("plan_ms_median", rs)} |')
     worlds = sorted({r['world'] for r in runs})
