@@ -29,6 +29,8 @@ SAME_GOAL = 1e-3
 DISTANCE_FIELD_SCANS = 5
 #: ... and covers this much around the scan that made it [m].
 DISTANCE_FIELD_MARGIN = 1.0
+#: Returns this far beyond a moving track's disc are the alignment's again [m].
+MOVING_MARGIN = 0.3
 
 
 class NavigationMemory:
@@ -77,17 +79,24 @@ class NavigationMemory:
                          transient)
         return True
 
-    def align(self, scan: Scan, predicted: ArrayLike) -> Match:
+    def align(self, scan: Scan, predicted: ArrayLike,
+              moving: tuple[NDArray, NDArray] | None = None) -> Match:
         """Match ``scan`` (its geometry checked) to the map: the pose of base_footprint
         (core/alignment.py) from the ``predicted`` one (x, y, yaw) in the map's frame.
-        The distance field is reused for DISTANCE_FIELD_SCANS scans while it covers the
-        scan."""
+        ``moving``: discs (centres (k, 2), radii (k,) [m]) whose returns, and
+        MOVING_MARGIN around them, take no part. The distance field is reused for
+        DISTANCE_FIELD_SCANS scans while it covers the scan."""
         base = scan_to_points(scan, (0.0, 0.0, 0.0), self.cfg.laser_mount,
                               self.cfg.obstacle_range)
         pred = np.asarray(predicted, float)
+        here = to_parent(pred, base)
+        if moving is not None and len(moving[0]) and len(base):
+            centres, radii = moving
+            d = np.hypot(*(here[:, None, :] - centres[None]).transpose(2, 0, 1))
+            still = np.all(d > radii[None] + MOVING_MARGIN, axis=1)
+            base, here = base[still], here[still]
         if len(base) == 0:
             return align(base, pred, None)
-        here = to_parent(pred, base)
         f = self._distance
         reach = np.array([0.0, 0.0]) if f is None else f.origin + np.array(
             f.values.shape[::-1]) * f.resolution

@@ -319,9 +319,23 @@ class Planner:
             return
         self._aligned_stamp = scan.stamp
         predicted = self.in_map(scan_pose)
-        self.match = self.memory.align(scan, predicted)
+        self.match = self.memory.align(scan, predicted, self._moving_discs(scan.stamp))
         if self.match.accepted and not np.array_equal(self.match.pose, predicted):
             self.correction = compose(self.match.pose, invert(scan_pose))
+
+    def _moving_discs(self, t: float) -> tuple[NDArray, NDArray]:
+        """Where the last scan's tracks that move, are held out of the memory or seem to
+        move (speed at least moving_speed) are at time ``t`` [s] (k, 2), and their radii
+        (k,) [m]: the scan alignment leaves their returns out (a walker written into the
+        map before it was known to move would otherwise drag the pose with it)."""
+        last = self.tracker.last
+        if last is None or not len(last.position):
+            return np.zeros((0, 2)), np.zeros(0)
+        speed = np.hypot(*last.velocity.T)
+        keep = last.held | last.moving | (speed >= self.cfg.moving_speed)
+        dt = t - self.tracker.time if math.isfinite(t) and self.tracker.time is not None \
+            else 0.0
+        return last.position[keep] + dt * last.velocity[keep], last.radius[keep]
 
     def _anchored(self, goal: NDArray) -> NDArray[np.float64]:
         """The goal (x, y) in the memory's frame: a goal given in odom is the place odom

@@ -161,6 +161,11 @@ class Tracker:
         self.time: float | None = None
         self._last: Tracks | None = None
 
+    @property
+    def last(self) -> Tracks | None:
+        """The tracks of the last scan taken (None before the first)."""
+        return self._last
+
     def _append(self, **rows: NDArray) -> None:
         """New tracks: the rows of every PER_TRACK array."""
         for name in self.PER_TRACK:
