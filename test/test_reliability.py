@@ -222,7 +222,8 @@ def test_odometry_time_going_back_clears_history():
     assert len(ctl.poses) == 1
 
 
-@pytest.mark.parametrize('goal, frame', [((math.nan, 1.0), 'odom'), ((1.0, 1.0), 'map')])
+@pytest.mark.parametrize('goal, frame', [((math.nan, 1.0), 'odom'), ((1.0, 1.0), 'base_link'),
+                                         ((math.inf, 1.0), 'map')])
 def test_bad_goals_are_refused(node, goal, frame):
     node.ctl.goal = None
     node._on_goal(goal_msg(*goal, frame=frame))
