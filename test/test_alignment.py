@@ -112,7 +112,7 @@ def _drive_between(world, sim_cfg, legs):
     from subapf_planner.core.loop import DecisionLoop
     from subapf_planner.core.status import State
     from subapf_planner.sim.simulator import BurgerSim
-    ctl = DecisionLoop(PlannerConfig())
+    ctl = DecisionLoop(PlannerConfig(scan_alignment=True))
     goals = [np.asarray(world.goal, float), np.asarray(world.start[:2], float)] * legs
     misses, driven, corrected, odometry = [], 0.0, [], []
     ctl.set_goal(goals[0], in_map=True)

@@ -128,10 +128,12 @@ class PlannerConfig:
     field_period: float = param(1.0, 'Shortest time between two field computations (sooner '
                                 'for a new goal, or when the robot leaves the patch)', 's',
                                 0.0, 60.0)
-    scan_alignment: bool = param(True, 'Match each scan to the memory before it is written '
+    scan_alignment: bool = param(False, 'Match each scan to the memory before it is written '
                                  '(core/alignment.py): drifting wheel odometry is corrected, '
                                  'and the memory, the field and the goal live in the '
-                                 'corrected frame (with the geodesic attraction)')
+                                 'corrected frame (with the geodesic attraction). Off by '
+                                 'default: among people it can follow a walker not yet '
+                                 'known to move (README, Getting there in buildings)')
     # --- moving obstacles (core/tracking.py, core/evasion.py) ------------------------
     track_moving: bool = param(True, 'Track moving obstacles from the scans (clusters, '
                                'constant-velocity Kalman filters): their points stay out of '
