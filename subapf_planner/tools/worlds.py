@@ -1,7 +1,8 @@
 """``subapf-worlds``: write a seeded suite of procedural worlds (format v1 YAML).
 
 ``subapf-worlds --out DIR [--count 210] [--seed 2026] [--families barn,maze,...]``
-(``--families dynamic``: every family with moving obstacles) writes
+(``--families dynamic``: every family with moving obstacles; ``--families
+building``: office floors, sim/building.py) writes
 DIR/<family>_<index>.yaml for each world of ``sim.worldgen.suite`` (the families
 take turns; the same seed writes the same files) and prints, per family,
 the number of worlds, their mean obstacle count and mean geodesic length.
