@@ -17,6 +17,7 @@ import time
 import numpy as np
 
 from ..core.config import METHODS, load_config
+from ..core.occupancy import OccupancyGrid
 from ..ros.paths import default_params_file, shipped_worlds_dir
 from ..sim.episode import run_episode
 from ..sim.simulator import SimConfig
@@ -72,8 +73,10 @@ def main(argv: list[str] | None = None) -> int:
     if cfg.geodesic:
         field_bytes = cells * (FIELD_BYTES_PER_BLOCK / cfg.field_coarsening ** 2
                                + FIELD_BYTES_PER_MAP_CELL)
-        print(f'memory: occupancy window {cells * 4 / 2**20:.2f} MiB (float32), field at most '
-              f'{field_bytes / 2**20:.2f} MiB (the whole window)')
+        grid_bytes = OccupancyGrid(cfg.map_resolution, cfg.map_size).nbytes
+        print(f'memory: occupancy window {grid_bytes / 2**20:.2f} MiB (log odds and the '
+              f"returns' mean place per cell), field at most {field_bytes / 2**20:.2f} MiB "
+              '(the whole window)')
     return 0
 
 
