@@ -60,16 +60,20 @@ class OccupancyGrid:
     Not thread-safe; one per robot.
     """
 
-    def __init__(self, resolution: float, size: float) -> None:
+    def __init__(self, resolution: float, size: float, hit_places: bool = False) -> None:
         if not (math.isfinite(resolution) and resolution > 0.0):
             raise ValueError(f'map resolution must be positive, got {resolution}')
         self.resolution = float(resolution)
         self.cells = max(8, int(math.ceil(size / resolution)))
         self.log_odds = np.zeros((self.cells, self.cells), np.float32)
-        #: Mean place of the returns in each cell, from its centre (x, y) [m], over the
-        #: last HIT_MEMORY of them (the scan alignment's sub-cell wall position).
-        self.hit_offset = np.zeros((self.cells, self.cells, 2), np.float32)
-        self.hit_count = np.zeros((self.cells, self.cells), np.int16)
+        #: With ``hit_places`` (the scan alignment's sub-cell wall position; None
+        #: without): the mean place of the returns in each cell, from its centre
+        #: (x, y) [m], over the last HIT_MEMORY of them.
+        n = self.cells
+        self.hit_offset: NDArray[np.float32] | None = \
+            np.zeros((n, n, 2), np.float32) if hit_places else None
+        self.hit_count: NDArray[np.int16] | None = \
+            np.zeros((n, n), np.int16) if hit_places else None
         self.origin = np.array([-0.5, -0.5]) * self.cells * self.resolution
         self.version = 0   # bumped whenever the occupied set (log odds > 0) changed
 
@@ -82,7 +86,8 @@ class OccupancyGrid:
     @property
     def nbytes(self) -> int:
         """Memory held by the grid [bytes]."""
-        return int(self.log_odds.nbytes + self.hit_offset.nbytes + self.hit_count.nbytes)
+        layers = (self.log_odds, self.hit_offset, self.hit_count)
+        return int(sum(a.nbytes for a in layers if a is not None))
 
     def cell_of(self, points: ArrayLike) -> NDArray[np.int64]:
         """(row, col) of each point (n, 2) [m]; may lie outside the window."""
@@ -128,6 +133,9 @@ class OccupancyGrid:
         dx, dy = int(d[0]), int(d[1])
         layers = []
         for a in (self.log_odds, self.hit_offset, self.hit_count):
+            if a is None:   # no hit places kept
+                layers.append(a)
+                continue
             shifted = np.zeros_like(a)
             if abs(dx) < n and abs(dy) < n:
                 src_r = slice(max(dy, 0), n + min(dy, 0))
@@ -186,7 +194,8 @@ class OccupancyGrid:
         end_cols = x0 + c[marked] * length[marked] / res
         end_rows = y0 + s[marked] * length[marked] / res
         ends = self._flat(end_cols, end_rows, box)
-        self._note_hits(end_cols, end_rows, box)
+        if self.hit_offset is not None:
+            self._note_hits(end_cols, end_rows, box)
         # each touched cell changes once however many beams touch it; a return wins
         mark = np.zeros((r1 - r0) * (c1 - c0), np.int8)
         mark[free] = 1

@@ -73,10 +73,10 @@ def main(argv: list[str] | None = None) -> int:
     if cfg.geodesic:
         field_bytes = cells * (FIELD_BYTES_PER_BLOCK / cfg.field_coarsening ** 2
                                + FIELD_BYTES_PER_MAP_CELL)
-        grid_bytes = OccupancyGrid(cfg.map_resolution, cfg.map_size).nbytes
-        print(f'memory: occupancy window {grid_bytes / 2**20:.2f} MiB (log odds and the '
-              f"returns' mean place per cell), field at most {field_bytes / 2**20:.2f} MiB "
-              '(the whole window)')
+        grid_bytes = OccupancyGrid(cfg.map_resolution, cfg.map_size, cfg.scan_alignment).nbytes
+        print(f'memory: occupancy window {grid_bytes / 2**20:.2f} MiB (log odds, and with '
+              f"scan_alignment the returns' mean place per cell), field at most "
+              f'{field_bytes / 2**20:.2f} MiB (the whole window)')
     return 0
 
 
