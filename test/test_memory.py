@@ -227,11 +227,34 @@ def test_memory_recomputes_on_a_new_goal_and_at_most_every_field_period():
     mem.field_for((0, 0), (0.0, 1.0), now=0.4)
     assert mem.recomputed                        # new goal
     mem.integrate(Scan(*enclosure_scan(1.2), 1.5), (0.0, 0.0, 0.0))
-    mem.field_for((0, 0), (0.0, 1.0), now=1.5)
-    assert mem.recomputed                        # grid changed, field_period over
+    before = mem.field
+    assert mem.field_for((0, 0), (0.0, 1.0), now=1.5) is before   # grid changed, period
+    assert not mem.recomputed                    # over: marched in the worker ...
+    after = mem.field_for((0, 0), (0.0, 1.0), now=1.7)
+    assert mem.recomputed and after is not before   # ... and taken at the next call
+    # the field marched in the worker is the one the cycle would have computed
+    alone = NavigationMemory(cfg)
+    for r, t in ((2.0, 0.0), (1.5, 0.2), (1.2, 1.5)):
+        alone.integrate(Scan(*enclosure_scan(r), t), (0.0, 0.0, 0.0))
+    np.testing.assert_array_equal(alone.field_for((0, 0), (0.0, 1.0)).values, after.values)
     mem.integrate(Scan(*enclosure_scan(1.2), 3.0), (0.0, 0.0, 0.0))
     mem.field_for((0, 0), (0.0, 1.0), now=3.0)
     assert not mem.recomputed                    # the same walls seen again: no change
+
+
+def test_a_field_being_marched_is_dropped_for_a_new_goal_or_a_forgotten_map():
+    mem = NavigationMemory(PlannerConfig(field_period=1.0))
+    mem.integrate(Scan(*enclosure_scan(2.0), 0.0), (0.0, 0.0, 0.0))
+    mem.field_for((0, 0), (1.0, 0.0), now=0.0)
+    mem.integrate(Scan(*enclosure_scan(1.5), 1.2), (0.0, 0.0, 0.0))
+    mem.field_for((0, 0), (1.0, 0.0), now=1.2)   # marching the map's changes
+    new_goal = mem.field_for((0, 0), (0.0, 1.0), now=1.4)
+    assert mem.recomputed and np.allclose(new_goal.goal, (0.0, 1.0))   # in the cycle
+    assert mem.field_for((0, 0), (0.0, 1.0), now=1.6) is new_goal   # the old job: gone
+    mem.integrate(Scan(*enclosure_scan(1.2), 2.6), (0.0, 0.0, 0.0))
+    mem.field_for((0, 0), (0.0, 1.0), now=2.6)
+    mem.forget()
+    assert mem.field is None and mem.field_for((0, 0), (0.0, 1.0), now=2.8) is not None
 
 
 def test_a_thinned_polyline_keeps_its_ends_and_its_spacing():

@@ -253,6 +253,49 @@ def test_memory_topics_can_be_switched_off(harness):
     assert got == [] and len(h.cmds) >= 3
 
 
+def test_views_are_built_only_while_something_subscribes(harness, monkeypatch):
+    """Markers, map, plan and correction cost nothing with nobody listening: not even
+    built (the builders are counted); a subscriber gets them from its next cycle on."""
+    from visualization_msgs.msg import MarkerArray
+
+    import subapf_planner.ros.planner_node as planner_node
+    built = {'markers': 0, 'map': 0, 'plan': 0, 'correction': 0}
+
+    def counted(name, build):
+        def wrapper(*args, **kwargs):
+            built[name] += 1
+            return build(*args, **kwargs)
+        return wrapper
+    for name, attr in (('markers', 'markers_from_result'), ('map', 'grid_to_msg'),
+                       ('plan', 'path_to_msg'), ('correction', 'transform_msg')):
+        monkeypatch.setattr(planner_node, attr, counted(name, getattr(planner_node, attr)))
+    h = harness()
+    h.goal(3.0, 0.0)
+    assert h.spin_until(lambda: (h.feed(), sum(c.twist.linear.x > 0 for c in h.cmds) >= 5)[1])
+    assert built == {'markers': 0, 'map': 0, 'plan': 0, 'correction': 0}
+    got = []
+    h.peer.create_subscription(MarkerArray, '/subapf_planner/markers', got.append, 10)
+    assert h.spin_until(lambda: (h.feed(), len(got) >= 3)[1])
+    assert built['markers'] >= 3 and built['map'] == built['plan'] == 0
+    assert {m.ns for m in got[-1].markers} >= {'obstacles', 'samples', 'danger_circle'}
+
+
+def test_scans_and_odometry_are_taken_at_the_tick_not_by_the_executor(harness):
+    """The inputs' subscriptions are in a group the executor never runs (PolledGroup):
+    a scan and odometry that arrived wait in their queues until the planning tick."""
+    h = harness(planning_frequency=1.0)
+    h.goal(3.0, 0.0)
+    assert h.spin_until(lambda: any(s.startswith('waiting') for s in h.states))
+    for _ in range(3):   # just after a tick: the next is a second away
+        h.feed()
+    polled = [sub for sub, _ in h.node._inputs]
+    assert all(not sub.callback_group.can_execute(sub) for sub in polled)
+    h.spin_until(lambda: False, timeout=0.3)   # the executor ran, the 1 Hz tick did not
+    assert h.node.ctl.scan is None and h.node.ctl.pose is None
+    assert h.spin_until(lambda: bool(h.cmds), timeout=3.0)   # the tick took them in
+    assert h.node.ctl.scan is not None and h.node.ctl.pose is not None
+
+
 def test_spin_node_bad_input_only_while_building_bugs_keep_their_traceback():
     """ros/spinning.py: a bad_input exception from the constructor is a clear message
     and exit code 2; the same exception type raised while spinning is a bug: it

@@ -119,3 +119,22 @@ def test_odometry_drift_grows_as_configured():
     assert turned_odom[-1] / turned_true[-1] == pytest.approx(1.03, abs=2e-3)
     true, odom = _drive(SimConfig(), [(0.2, 0.5, 4.0)])
     np.testing.assert_array_equal(true, odom)
+
+
+def test_solver_iterations_reach_the_physics_engine():
+    import pybullet
+    for n in (50, 10):
+        with BurgerSim(world(), SimConfig(solver_iterations=n)) as sim:
+            got = pybullet.getPhysicsEngineParameters(physicsClientId=sim._cid)
+            assert got['numSolverIterations'] == n
+    with pytest.raises(ValueError, match='solver_iterations'):
+        SimConfig(solver_iterations=0)
+
+
+def test_perfect_odometry_starts_at_the_start_and_then_is_the_true_pose():
+    with BurgerSim(world(start=(1.0, -2.0, 0.3)), SimConfig()) as sim:
+        np.testing.assert_array_equal(sim.odometry()[0], [1.0, -2.0, 0.3])
+        sim.set_command(0.2, 0.5)
+        sim.step(0.4)
+        np.testing.assert_array_equal(sim.odometry()[0], sim.true_pose())
+        assert sim.odometry()[0][0] > 1.05

@@ -114,6 +114,11 @@ class DecisionLoop:
         """The occupancy memory (read it, do not change it)."""
         return self.planner.memory.grid
 
+    def settle(self) -> None:
+        """Let work started after a tick finish (the navigation field marched between
+        cycles: core/memory.py); the next tick's decisions are the same either way."""
+        self.planner.memory.settle()
+
     def seed_command(self, command: tuple[float, float]) -> None:
         """The command the robot was last sent by someone else (a replay that starts
         mid-run): the next command's acceleration limits start from it."""

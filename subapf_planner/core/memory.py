@@ -6,11 +6,23 @@ the field covers, or, when the occupied cells changed, at most every
 ``field_period`` seconds (the field is the expensive part of a cycle;
 core/navigation.py). A scan that only confirms what the map holds changes no
 occupied cell and costs no field.
+
+A field that is needed at once (a new goal, a place avoided or opened again, the
+robot off the patch, no field yet) is computed in the cycle. One that only brings
+the map's changes in is marched on a worker thread from the cycle's map, while
+the cycle goes on with the field it has, and is taken at the next call (waited
+for if it is not done yet): the same calls give the same fields whatever the
+timing (the bench, the replay and the node agree), and a planning tick no longer
+waits for the marching (a node's thread is idle between ticks; the marching
+holds the GIL, so it takes no time from anything but that idle time).
 """
 
 from __future__ import annotations
 
+from concurrent.futures import Future, ThreadPoolExecutor
 import math
+import time
+import weakref
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -55,10 +67,16 @@ class NavigationMemory:
         self._scan_stamp: float | None = None
         self.recomputed = False   # whether the last field_for() computed a new field
         self.computations = 0     # fields computed so far
+        #: How long the last field took to compute [s] (wall clock, in the cycle or the
+        #: worker: a figure for subapf-perf, not for decisions).
+        self.compute_seconds = 0.0
         self._distance: DistanceField | None = None   # the alignment's, and its age
         self._distance_age = 0
         #: Places tried and not passed: (x, y, radius [m], until [s]) (see ``avoid``).
         self.avoided: list[tuple[float, float, float, float]] = []
+        #: The field being marched in the worker, with its (key, time) once taken.
+        self._pending: tuple[Future, tuple, float] | None = None
+        self._worker: ThreadPoolExecutor | None = None
 
     def reconfigure(self, cfg: PlannerConfig) -> None:
         """A new configuration; a new map size or resolution, or the scan alignment
@@ -68,6 +86,7 @@ class NavigationMemory:
             self.forget()
         self.cfg = cfg
         self._field_key = None
+        self._drop_pending()
 
     def forget(self) -> None:
         """Drop the map and the field (the world may have changed: a restarted simulation)."""
@@ -76,6 +95,50 @@ class NavigationMemory:
         self._scan_stamp = None
         self._distance, self._distance_age = None, 0
         self.avoided = []
+        self._drop_pending()
+
+    def _drop_pending(self) -> None:
+        """Forget the field being marched (its result, once done, is dropped)."""
+        if self._pending is not None:
+            self._pending[0].cancel()
+            self._pending = None
+
+    def settle(self) -> None:
+        """Wait until the field being marched (if any) is done; the next call takes it
+        as it would have anyway. What a node's idle time between ticks gives the worker,
+        for a caller with no idle time (the bench's simulator holds the GIL)."""
+        if self._pending is not None:
+            self._pending[0].exception()
+
+    def _march_later(self, goal: NDArray, position: NDArray, now: float) -> None:
+        """Start marching the field of the map as it is now on the worker thread."""
+        if self._worker is None:
+            self._worker = ThreadPoolExecutor(max_workers=1, thread_name_prefix='field')
+            weakref.finalize(self, self._worker.shutdown, wait=False)
+        job = self._worker.submit(self._compute, self._blocked(now), self.grid.origin.copy(),
+                                  goal, position)
+        self._pending = (job, self._key(goal), now)
+
+    def _compute(self, blocked: NDArray[np.bool_], origin: NDArray, goal: NDArray,
+                 position: NDArray) -> tuple[NavigationField | None, float]:
+        """The field, and how long it took [s]."""
+        cfg = self.cfg
+        t0 = time.perf_counter()
+        field = compute_field(blocked, origin, self.grid.resolution, goal, position,
+                              inflation_radius=cfg.inflation_radius,
+                              clearance_band=cfg.inflation_band,
+                              coarsening=cfg.field_coarsening)
+        return field, time.perf_counter() - t0
+
+    def _install(self, computed: tuple[NavigationField | None, float], key: tuple,
+                 when: float) -> None:
+        self.field, self.compute_seconds = computed
+        self._field_key, self._field_time = key, when
+        self.recomputed = True
+        self.computations += 1
+
+    def _key(self, goal: NDArray) -> tuple:
+        return (tuple(np.round(goal / SAME_GOAL).astype(int)), self.grid.version)
 
     def integrate(self, scan: Scan, scan_pose: ArrayLike, goal: ArrayLike | None = None,
                   transient: NDArray[np.bool_] | None = None) -> bool:
@@ -128,6 +191,7 @@ class NavigationMemory:
         place is open again)."""
         self.avoided.append((float(point[0]), float(point[1]), float(radius), float(until)))
         self._field_key = None
+        self._drop_pending()
 
     def _blocked(self, now: float | None) -> NDArray[np.bool_]:
         """The occupied cells plus the avoided places still in force at ``now``."""
@@ -179,25 +243,27 @@ class NavigationMemory:
     def field_for(self, position: ArrayLike, goal: ArrayLike,
                   now: float | None = None) -> NavigationField | None:
         """The field to ``goal`` (None: the goal is blocked in the map), recomputed per the
-        module docstring; ``now`` None recomputes whenever the occupied cells changed."""
+        module docstring; ``now`` None recomputes whenever the occupied cells changed, in
+        the call."""
         p = np.asarray(position, float)[:2]
         g = np.asarray(goal, float)[:2]
+        self.recomputed = False
+        if self._pending is not None:   # the field marched since the last call
+            job, key, started = self._pending
+            self._pending = None
+            self._install(job.result(), key, started)
         if now is not None and any(now >= a[3] for a in self.avoided):
             self._field_key = None   # an avoided place opens again
-        key = (tuple(np.round(g / SAME_GOAL).astype(int)), self.grid.version)
+        key = self._key(g)
         same_goal = self._field_key is not None and self._field_key[0] == key[0]
         fresh = same_goal and (key[1] == self._field_key[1] or (
             now is not None and now - self._field_time < self.cfg.field_period))
-        self.recomputed = False
-        if fresh and (self.field is None or self._covers(p)):
+        covered = self.field is None or self._covers(p)
+        if fresh and covered:
             return self.field
-        cfg = self.cfg
-        self.field = compute_field(self._blocked(now), self.grid.origin, self.grid.resolution,
-                                   g, p, inflation_radius=cfg.inflation_radius,
-                                   clearance_band=cfg.inflation_band,
-                                   coarsening=cfg.field_coarsening)
-        self._field_key = key
-        self._field_time = -math.inf if now is None else now
-        self.recomputed = True
-        self.computations += 1
+        if same_goal and covered and self.field is not None and now is not None:
+            self._march_later(g, p, now)   # only the map's changes: the next call has it
+            return self.field
+        self._install(self._compute(self._blocked(now), self.grid.origin, g, p), key,
+                      -math.inf if now is None else now)
         return self.field

@@ -29,7 +29,7 @@ def _marker(ns: str, mid: int, mtype: int, frame: str, stamp: Time, scale: float
 
 
 def _points(xy: np.ndarray) -> list[Point]:
-    return [Point(x=float(x), y=float(y), z=0.0) for x, y in np.asarray(xy).reshape(-1, 2)]
+    return [Point(x=x, y=y) for x, y in np.asarray(xy, float).reshape(-1, 2).tolist()]
 
 
 def _placed(m: Marker, pose: tuple[float, float, float]) -> Marker:

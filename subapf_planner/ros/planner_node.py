@@ -10,7 +10,11 @@ Topics (relative, so namespaces and remapping work):
        ~/plan (nav_msgs/Path, the navigation field's steepest descent, sent for each
        new field and as the robot moves), ~/correction (geometry_msgs/
        TransformStamped map_frame -> odom: the scan alignment's drift correction);
-       markers, map and plan are drawn in odom
+       markers, map and plan are drawn in odom; everything but cmd_vel is built and
+       sent only while something subscribes
+
+Scans and odometry are taken at the planning tick (ros/spinning.PolledGroup), so
+only the timer (and goals, parameters, /clock) wakes the process.
 
 The node only translates messages and parameters and drives one timer; the
 decisions are subapf_planner.core.loop's, the input checks ros/intake.py's.
@@ -30,7 +34,7 @@ from rclpy.clock import JumpThreshold
 from rclpy.duration import Duration
 from rclpy.exceptions import ParameterException
 from rclpy.node import Node
-from rclpy.qos import qos_profile_sensor_data
+from rclpy.qos import QoSProfile, qos_profile_sensor_data
 from sensor_msgs.msg import LaserScan
 from std_msgs.msg import String
 from visualization_msgs.msg import MarkerArray
@@ -45,8 +49,8 @@ from .conversions import cmd_to_msg, grid_to_msg, path_to_msg, transform_msg
 from .intake import Intake
 from .markers import markers_from_result
 from .parameters import declare, read
-from .qos import LATCHED
-from .spinning import spin_node
+from .qos import LATCHED, listened
+from .spinning import PolledGroup, spin_node
 
 NODE_NAME = 'subapf_planner'
 #: A forward clock jump longer than this, or any backward one, resets the inputs [s].
@@ -56,7 +60,9 @@ CLOCK_JUMP = 1.0
 PLAN_SPACING = 0.25
 #: Longest time between two ~/plan messages while the field is used [s].
 PLAN_PERIOD = 1.0
-
+#: Odometry queued between two ticks (taken at the tick, not on arrival): 2.5 s at 20 Hz,
+#: 10 planning periods of the default.
+ODOM_QUEUE = 50
 
 
 @dataclass(frozen=True)
@@ -71,14 +77,18 @@ class NodeOptions:
                           -1e6, 1e6, read_only=True)
     enable_stamped_cmd_vel: bool = param(True, 'Publish TwistStamped (true) or Twist (false)',
                                          read_only=True)
-    publish_markers: bool = param(True, 'Publish ~/markers every cycle (costs about 1 ms of '
-                                  'CPU)')
+    publish_markers: bool = param(True, 'Publish ~/markers (visualization_msgs/MarkerArray) '
+                                  'at marker_rate while something subscribes')
+    marker_rate: float = param(5.0, 'Largest rate of ~/markers (at most one per planning '
+                               'cycle)', 'Hz', 0.1, 50.0)
     publish_map: bool = param(True, 'Publish the occupancy memory on ~/map '
-                              '(nav_msgs/OccupancyGrid, transient local) at map_rate')
+                              '(nav_msgs/OccupancyGrid, transient local) at map_rate '
+                              'while something subscribes')
     map_rate: float = param(1.0, 'Rate of ~/map', 'Hz', 0.1, 5.0)
     publish_plan: bool = param(True, "Publish the field's steepest-descent path from the "
                                'robot on ~/plan (nav_msgs/Path) for each new field, and '
-                               'when the robot moved 0.25 m or a second passed')
+                               'when the robot moved 0.25 m or a second passed, while '
+                               'something subscribes')
     laser_frame: str = param('base_scan', 'Expected scan frame_id; empty accepts any')
     odom_frame: str = param('odom', 'Frame of odometry and goals')
     map_frame: str = param('map', "Name of the memory's frame (odom as it was at the start, "
@@ -116,11 +126,16 @@ class PlannerNode(Node):
         self.plan_pub = self.create_publisher(Path, '~/plan', 10)
         self.correction_pub = self.create_publisher(TransformStamped, '~/correction', 10)
         self._map_time: float | None = None
+        self._markers_time: float | None = None
         self._plan_sent: tuple | None = None   # (field, robot position, time) of ~/plan
+        # taken at the tick (_take_arrived_inputs), never by the executor
+        polled = PolledGroup()
         self._inputs = (
-            (self.create_subscription(LaserScan, 'scan', self._on_scan,
-                                      qos_profile_sensor_data), self._on_scan),
-            (self.create_subscription(Odometry, 'odom', self._on_odom, 10), self._on_odom))
+            (self.create_subscription(LaserScan, 'scan', self._on_scan, qos_profile_sensor_data,
+                                      callback_group=polled), self._on_scan),
+            (self.create_subscription(Odometry, 'odom', self._on_odom,
+                                      QoSProfile(depth=ODOM_QUEUE), callback_group=polled),
+             self._on_odom))
         self.create_subscription(PoseStamped, 'goal_pose', self._on_goal, 10)
 
         self._last_state = ''
@@ -199,9 +214,9 @@ class PlannerNode(Node):
 
     # --- the planning cycle -----------------------------------------------------------
     def _take_arrived_inputs(self, tick_ns: int) -> list:
-        """Scans and odometry that have arrived but that the executor has not handed over
-        yet (it runs a ready timer first): those stamped at or before the tick are taken
-        in now, as a replay of the recording orders them; later ones are returned, to be
+        """The scans and odometry that arrived since the last tick (the executor never
+        hands them over: PolledGroup): those stamped at or before the tick are taken in
+        now, as a replay of the recording orders them; later ones are returned, to be
         taken in after the tick."""
         later = []
         for sub, handler in self._inputs:
@@ -222,21 +237,30 @@ class PlannerNode(Node):
             handler(msg)
         if decision.command is not None:   # the command first, stamped with the tick time
             self._publish_cmd(*decision.command, stamp=tick.to_msg())
-        if decision.result is not None and self.options.publish_markers:
-            cfg = self.ctl.cfg
-            self.marker_pub.publish(markers_from_result(
-                decision.result, self.options.odom_frame, tick.to_msg(),
-                cfg.danger_distance, cfg.voxel_size))
-        if decision.result is not None and self.ctl.cfg.geodesic:
-            self.correction_pub.publish(transform_msg(
-                self.options.map_frame, self.options.odom_frame,
-                (*decision.result.correction[:2], 0.0), decision.result.correction[2],
-                tick.nanoseconds * 1e-9))
+        self._publish_views(decision, tick)
         self._publish_memory(decision, tick)
         if decision.state.halted and decision.text != self._last_state:
             self.get_logger().warn(decision.text)
         self._last_state = decision.text
-        self.status_pub.publish(String(data=decision.text))
+        if listened(self.status_pub):
+            self.status_pub.publish(String(data=decision.text))
+
+    def _publish_views(self, decision, tick) -> None:
+        """~/markers at marker_rate and ~/correction each cycle, each only while
+        something subscribes."""
+        result, now, cfg = decision.result, tick.nanoseconds * 1e-9, self.ctl.cfg
+        if result is None:
+            return
+        if self.options.publish_markers and listened(self.marker_pub) \
+                and _due(self._markers_time, now, 1.0 / self.options.marker_rate, cfg.period):
+            self._markers_time = now
+            self.marker_pub.publish(markers_from_result(
+                result, self.options.odom_frame, tick.to_msg(), cfg.danger_distance,
+                cfg.voxel_size))
+        if cfg.geodesic and listened(self.correction_pub):
+            self.correction_pub.publish(transform_msg(
+                self.options.map_frame, self.options.odom_frame,
+                (*result.correction[:2], 0.0), result.correction[2], now))
 
     def _publish_memory(self, decision, tick) -> None:
         """~/plan for each new field, and when the robot moved PLAN_SPACING or PLAN_PERIOD
@@ -247,18 +271,20 @@ class PlannerNode(Node):
         result = decision.result
         field = result.field if result is not None else None
         memory_frame = invert(self.ctl.planner.correction)   # its pose in odom
-        if self.options.publish_plan and field is not None and result.pose is not None:
+        if self.options.publish_plan and field is not None and result.pose is not None \
+                and listened(self.plan_pub):
             here = result.pose[:2]
             last = self._plan_sent
-            if last is None or last[0] is not field or now < last[2] \
-                    or now - last[2] >= PLAN_PERIOD \
+            if last is None or last[0] is not field \
+                    or _due(last[2], now, PLAN_PERIOD, self.ctl.cfg.period) \
                     or np.hypot(*(here - last[1])) >= PLAN_SPACING:
                 self._plan_sent = (field, here.copy(), now)
                 self.plan_pub.publish(path_to_msg(
                     to_parent(memory_frame, thin_polyline(field.path(here), PLAN_SPACING)),
                     frame, tick.to_msg()))
-        if self.options.publish_map and (self._map_time is None or now < self._map_time
-                                         or now - self._map_time >= 1.0 / self.options.map_rate):
+        if self.options.publish_map and listened(self.map_pub) \
+                and _due(self._map_time, now, 1.0 / self.options.map_rate,
+                         self.ctl.cfg.period):
             self._map_time = now
             self.map_pub.publish(grid_to_msg(self.ctl.grid, frame, tick.to_msg(),
                                              memory_frame))
@@ -275,6 +301,13 @@ class PlannerNode(Node):
     def stop_robot(self) -> None:
         """Zero velocity, e.g. on shutdown."""
         self._publish_cmd(0.0, 0.0)
+
+
+def _due(last: float | None, now: float, period: float, tick: float) -> bool:
+    """Whether a message last sent at ``last`` [s] (None: never) is due again at the
+    planning tick ``now``: ``period`` [s] later to the nearest tick (ticks are ``tick``
+    [s] apart), or the clock went back."""
+    return last is None or now < last or now - last >= period - 0.5 * tick
 
 
 def main(args: list[str] | None = None) -> int:

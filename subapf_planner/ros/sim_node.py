@@ -42,7 +42,7 @@ from .conversions import (
 )
 from .markers import moving_obstacle_markers
 from .parameters import declare, read
-from .qos import LATCHED
+from .qos import LATCHED, listened
 from .spinning import spin_node
 
 #: Simulated time per timer tick [s]; odometry and /clock go out every tick.
@@ -137,14 +137,16 @@ class SimNode(Node):
         t = sim.time
         pose, twist = sim.odometry()
         self.odom_pub.publish(odom_to_msg(pose, twist, t))
-        if self.tf_pub is not None:
+        if self.tf_pub is not None and listened(self.tf_pub):
             self.tf_pub.publish(self._tf_message(transforms=[transform_msg(
                 'odom', 'base_footprint', (pose[0], pose[1], 0.0), pose[2], t)]))
-        self.truth_pub.publish(odom_to_msg(sim.true_pose(), twist, t, 'world'))
+        if listened(self.truth_pub):
+            self.truth_pub.publish(odom_to_msg(sim.true_pose(), twist, t, 'world'))
         if t + 1e-9 >= self._next_scan:
             self._next_scan += SCAN_PERIOD
             self._scans.capture(scan_to_msg(replace(sim.scan(), stamp=t), 'base_scan'), t)
-            if self.moving_pub is not None:   # where they truly are, at the scan rate
+            if self.moving_pub is not None and listened(self.moving_pub):
+                # where they truly are, at the scan rate
                 self.moving_pub.publish(moving_obstacle_markers(
                     self.world.moving_at(t), 'odom', seconds_to_stamp(t)))
         # scans go out scan_latency after capture, stamped with their capture time

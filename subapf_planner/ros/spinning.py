@@ -9,6 +9,7 @@ import threading
 import time
 
 import rclpy
+from rclpy.callback_groups import CallbackGroup
 from rclpy.duration import Duration
 from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
 from rclpy.node import Node
@@ -25,6 +26,23 @@ STOP_POLL = 0.1
 #: Prompt acknowledgements need the package's Fast DDS profile (config/fastdds.xml:
 #: heartbeats every 0.1 s; with Fast DDS's default of 3 s, a wait of 1 s times out).
 SHUTDOWN_ACK_TIMEOUT = 1.0
+
+
+class PolledGroup(CallbackGroup):
+    """A callback group the executor never waits on or runs: its subscriptions are taken
+    by the node itself (``sub.handle.take_message``) when it wants them, e.g. at its
+    planning tick, so 20 Hz odometry does not wake the process (each executor wake
+    rebuilds the wait set in Python: about 0.7 ms of CPU here, 2.8 ms per 5 Hz cycle).
+    Messages queue in the subscription (its QoS depth) until taken."""
+
+    def can_execute(self, entity) -> bool:
+        return False
+
+    def beginning_execution(self, entity) -> bool:
+        return False
+
+    def ending_execution(self, entity) -> None:
+        pass
 
 
 def stop_on_signals() -> threading.Event:

@@ -49,6 +49,9 @@ class EpisodeResult:
     times: np.ndarray = field(default_factory=lambda: np.zeros(0))
     #: A collision with the base commanded to stand still (it counts as a collision).
     hit_while_stopped: bool = False
+    #: Per new navigation field, how long computing it took [ms] (in the cycle, or on
+    #: the memory's worker thread between cycles: core/memory.py).
+    field_ms: np.ndarray = field(default_factory=lambda: np.zeros(0))
 
     @property
     def cycles(self) -> int:
@@ -89,7 +92,7 @@ def run_episode(world: World, cfg: PlannerConfig, sim_cfg: SimConfig | None = No
     cfg = cfg.replace(goal_tolerance=min(cfg.goal_tolerance, world.goal_tolerance))
     ctl = DecisionLoop(cfg, limits)
     ctl.set_goal(np.asarray(world.goal, float), in_map=True)   # a place in the world
-    path, times, plan_ms, recomputed, statuses = [], [], [], [], {}
+    path, times, plan_ms, recomputed, statuses, field_ms = [], [], [], [], {}, []
     with BurgerSim(world, sim_cfg) as sim:
         while True:
             truth = sim.true_pose()
@@ -108,11 +111,14 @@ def run_episode(world: World, cfg: PlannerConfig, sim_cfg: SimConfig | None = No
             delivery.capture(sim.scan(), now)
             for scan in delivery.due(now):
                 ctl.update_scan(scan, now)
+            ctl.settle()   # as a node's idle time between ticks would (not timed)
             t0 = time.perf_counter()
             decision = ctl.tick(now)
             if decision.result is not None:
                 plan_ms.append((time.perf_counter() - t0) * 1e3)
                 recomputed.append(decision.result.new_field)
+                if decision.result.new_field:
+                    field_ms.append(ctl.planner.memory.compute_seconds * 1e3)
             key = str(decision.result.command.status) if decision.result is not None \
                 else decision.text
             statuses[key] = statuses.get(key, 0) + 1
@@ -124,4 +130,4 @@ def run_episode(world: World, cfg: PlannerConfig, sim_cfg: SimConfig | None = No
         hit_while_stopped = outcome is Outcome.COLLISION and sim.hit_while_stopped
     return EpisodeResult(world.name, label or cfg.method, outcome, elapsed, np.asarray(path),
                          np.asarray(plan_ms), final, statuses, np.asarray(recomputed, bool),
-                         np.asarray(times), hit_while_stopped)
+                         np.asarray(times), hit_while_stopped, np.asarray(field_ms))

@@ -61,6 +61,10 @@ class SimConfig:
     """Simulator settings (SI units). Defaults: the burger and its LDS-01 in Gazebo."""
 
     physics_dt: float = param(0.005, 'Physics time step', 's', 1e-4, 0.05, read_only=True)
+    solver_iterations: int = param(50, "PyBullet's constraint-solver iterations per physics "
+                                   'step (its default, 50; fewer is faster and the wheels '
+                                   'slip differently: README, Performance)', '', 1, 500,
+                                   read_only=True)
     scan_beams: int = param(360, 'Lidar beams per sweep (LDS-01: 360)', '', 1, 4096,
                             read_only=True)
     range_min: float = param(0.12, 'Lidar minimum range', 'm', 0.0, 1.0, read_only=True)
@@ -105,6 +109,7 @@ class BurgerSim:
         self._rng = np.random.default_rng(self.config.seed)
         with _quiet_stdout():
             self._client = BulletClient(connection_mode=pybullet.DIRECT)
+        self._cid = self._client._client   # for the raw calls of every physics step
         self._build()
         self.time = 0.0
         self.collided = False
@@ -112,8 +117,10 @@ class BurgerSim:
         self.hit_while_stopped = False
         self._cmd = (0.0, 0.0)
         self._cmd_time = -math.inf
+        self._wheels_sent: tuple[float, float] | None = None   # motor targets [rad/s]
         x, y, yaw = world.start
-        self._odom = np.array([x, y, yaw])
+        #: The odometry pose; None: the true pose (perfect odometry once it moved).
+        self._odom: np.ndarray | None = np.array([x, y, yaw])
         self._truth_prev = self.true_pose()
         n = self.config.scan_beams
         self._angles = 2.0 * math.pi * np.arange(n) / n
@@ -123,6 +130,7 @@ class BurgerSim:
         c.resetSimulation()
         c.setGravity(0, 0, -9.81)
         c.setTimeStep(self.config.physics_dt)
+        c.setPhysicsEngineParameter(numSolverIterations=self.config.solver_iterations)
         plane = c.createCollisionShape(pybullet.GEOM_PLANE)
         self._plane = c.createMultiBody(0, plane)
         c.changeDynamics(self._plane, -1, lateralFriction=1.0)
@@ -185,82 +193,111 @@ class BurgerSim:
         return self._cmd
 
     def _apply_wheels(self) -> None:
+        """The wheel motors' target velocities for the base's (v, w), sent when they
+        change (PyBullet keeps a motor's target until it is set again)."""
         v, w = self._wheel_command()
-        left = (v - w * ROBOT.wheel_separation / 2) / ROBOT.wheel_radius
-        right = (v + w * ROBOT.wheel_separation / 2) / ROBOT.wheel_radius
-        self._client.setJointMotorControlArray(
-            self.robot, list(self._wheels), pybullet.VELOCITY_CONTROL,
-            targetVelocities=[left, right], forces=[self.config.wheel_torque] * 2)
+        targets = ((v - w * ROBOT.wheel_separation / 2) / ROBOT.wheel_radius,
+                   (v + w * ROBOT.wheel_separation / 2) / ROBOT.wheel_radius)
+        if targets != self._wheels_sent:
+            pybullet.setJointMotorControlArray(
+                self.robot, list(self._wheels), pybullet.VELOCITY_CONTROL,
+                targetVelocities=list(targets), forces=[self.config.wheel_torque] * 2,
+                physicsClientId=self._cid)
+            self._wheels_sent = targets
 
     def step(self, duration: float) -> None:
-        """Advance by ``duration`` seconds (rounded to whole physics steps)."""
-        c = self._client
-        for _ in range(max(1, int(round(duration / self.config.physics_dt)))):
+        """Advance by ``duration`` seconds (rounded to whole physics steps).
+
+        Every physics step: the wheel targets, the moving obstacles placed, the physics,
+        the odometry increment (only when odometry has errors: perfect odometry is the
+        true pose, read when asked), the contact check. The hot calls go to PyBullet
+        directly (BulletClient's wrapper costs a few microseconds a call)."""
+        dt = self.config.physics_dt
+        times = []
+        t = self.time
+        for _ in range(max(1, int(round(duration / dt)))):
+            t += dt   # (summed as self.time is, so the movers' times are the same floats)
+            times.append(t)
+        placed = self._mover_positions(np.asarray(times)) if self._movers else None
+        cid, perfect = self._cid, self._perfect_odometry
+        for i, t in enumerate(times):
             self._apply_wheels()
-            if self._movers:
-                self._place_movers(self.time + self.config.physics_dt)
-            c.stepSimulation()
-            self.time += self.config.physics_dt
-            self._integrate_odom()
+            if placed is not None:
+                self._place_movers(placed[:, i])
+            pybullet.stepSimulation(physicsClientId=cid)
+            self.time = t
+            if not perfect:
+                self._integrate_odom()
             if not self.collided and self._touching_obstacle():
                 self.collided = True
                 self.hit_while_stopped = self._wheel_command() == (0.0, 0.0)
+        if perfect:
+            self._odom = None   # the true pose, read when asked
 
-    def _place_movers(self, t: float) -> None:
-        """Put each moving obstacle where its path has it at time ``t`` [s]."""
-        reset = self._client.resetBasePositionAndOrientation
-        for body, orn, m in zip(self._movers, self._mover_orn, self.world.moving, strict=True):
-            x, y = m.position(t)
-            reset(body, [float(x), float(y), OBSTACLE_HEIGHT / 2], orn)
+    def _mover_positions(self, times: np.ndarray) -> np.ndarray:
+        """Centres (movers, len(times), 2) of the moving obstacles at ``times`` [s]."""
+        return np.stack([m.position(times) for m in self.world.moving])
+
+    def _place_movers(self, centres: np.ndarray) -> None:
+        """Put each moving obstacle at its centre (movers, 2) [m]."""
+        reset, cid, z = pybullet.resetBasePositionAndOrientation, self._cid, OBSTACLE_HEIGHT / 2
+        for body, orn, (x, y) in zip(self._movers, self._mover_orn, centres.tolist(),
+                                     strict=True):
+            reset(body, [x, y, z], orn, physicsClientId=cid)
 
     def _touching_obstacle(self) -> bool:
-        return any(cp[2] != self._plane for cp in self._client.getContactPoints(self.robot))
+        plane = self._plane
+        return any(cp[2] != plane
+                   for cp in pybullet.getContactPoints(self.robot, physicsClientId=self._cid))
+
+    @property
+    def _perfect_odometry(self) -> bool:
+        cfg = self.config
+        return cfg.odom_noise == 0.0 and cfg.odom_distance_scale == 1.0 \
+            and cfg.odom_yaw_scale == 1.0
 
     # --- state --------------------------------------------------------------------------
     def true_pose(self) -> np.ndarray:
         """Ground-truth (x, y, yaw) of base_footprint in the world frame."""
-        pos, orn = self._client.getBasePositionAndOrientation(self.robot)
-        yaw = self._client.getEulerFromQuaternion(orn)[2]
+        pos, orn = pybullet.getBasePositionAndOrientation(self.robot, physicsClientId=self._cid)
+        yaw = pybullet.getEulerFromQuaternion(orn)[2]
         return np.array([pos[0], pos[1], yaw])
 
     def true_velocity(self) -> tuple[float, float]:
         """Ground-truth forward speed [m/s] and yaw rate [rad/s] in the body frame."""
-        lin, ang = self._client.getBaseVelocity(self.robot)
+        lin, ang = pybullet.getBaseVelocity(self.robot, physicsClientId=self._cid)
         yaw = self.true_pose()[2]
         return lin[0] * math.cos(yaw) + lin[1] * math.sin(yaw), ang[2]
 
     def _integrate_odom(self) -> None:
-        """Odometry from the base's motion over the last physics step: the body-frame
-        increment (forward, lateral, yaw), scaled by odom_distance_scale (translation)
-        and odom_yaw_scale (rotation), each with relative noise odom_noise, added to the
-        odometry pose. The scales are the systematic error of wheel odometry: a driver
+        """Odometry with errors from the base's motion over the last physics step: the
+        body-frame increment (forward, lateral, yaw), scaled by odom_distance_scale
+        (translation) and odom_yaw_scale (rotation), each with relative noise odom_noise,
+        added to the odometry pose. The scales are the systematic error of wheel odometry: a driver
         that assumes wheels (1 + e_r) times their real radius and a separation (1 + e_b)
         times the real one reports (1 + e_r) times the distance and (1 + e_r) / (1 + e_b)
         times the turn (+2 % distance and +3 % turn: e_r = 0.02, e_b = -0.0097)."""
         truth = self.true_pose()
         cfg = self.config
-        if cfg.odom_noise == 0.0 and cfg.odom_distance_scale == 1.0 \
-                and cfg.odom_yaw_scale == 1.0:
-            self._odom = truth
-        else:
-            prev = self._truth_prev
-            c, s = math.cos(prev[2]), math.sin(prev[2])
-            dx, dy = truth[0] - prev[0], truth[1] - prev[1]
-            fwd, lat = c * dx + s * dy, -s * dx + c * dy
-            dyaw = math.remainder(truth[2] - prev[2], 2 * math.pi)
-            scale = np.array([cfg.odom_distance_scale, cfg.odom_distance_scale,
-                              cfg.odom_yaw_scale])
-            if cfg.odom_noise > 0.0:
-                scale = scale * (1.0 + cfg.odom_noise * self._rng.standard_normal(3))
-            fwd, lat, dyaw = np.array([fwd, lat, dyaw]) * scale
-            oc, os_ = math.cos(self._odom[2]), math.sin(self._odom[2])
-            self._odom = self._odom + [oc * fwd - os_ * lat, os_ * fwd + oc * lat, dyaw]
-            self._odom[2] = math.remainder(self._odom[2], 2 * math.pi)
+        prev = self._truth_prev
+        c, s = math.cos(prev[2]), math.sin(prev[2])
+        dx, dy = truth[0] - prev[0], truth[1] - prev[1]
+        fwd, lat = c * dx + s * dy, -s * dx + c * dy
+        dyaw = math.remainder(truth[2] - prev[2], 2 * math.pi)
+        scale = np.array([cfg.odom_distance_scale, cfg.odom_distance_scale,
+                          cfg.odom_yaw_scale])
+        if cfg.odom_noise > 0.0:
+            scale = scale * (1.0 + cfg.odom_noise * self._rng.standard_normal(3))
+        fwd, lat, dyaw = np.array([fwd, lat, dyaw]) * scale
+        oc, os_ = math.cos(self._odom[2]), math.sin(self._odom[2])
+        self._odom = self._odom + [oc * fwd - os_ * lat, os_ * fwd + oc * lat, dyaw]
+        self._odom[2] = math.remainder(self._odom[2], 2 * math.pi)
         self._truth_prev = truth
 
     def odometry(self) -> tuple[np.ndarray, tuple[float, float]]:
         """Odometry pose (x, y, yaw) in odom and body twist (v, w)."""
-        return self._odom.copy(), self.true_velocity()
+        pose = self.true_pose() if self._odom is None else self._odom.copy()
+        return pose, self.true_velocity()
 
     def scan(self) -> Scan:
         """One LDS-01-like sweep from base_scan at the current pose (+inf: no return)."""
@@ -271,7 +308,7 @@ class BurgerSim:
         n = a.size
         origin = np.tile([ox, oy, ROBOT.laser.z], (n, 1))
         ends = origin + cfg.range_max * np.column_stack((np.cos(a), np.sin(a), np.zeros(n)))
-        hits = self._client.rayTestBatch(origin.tolist(), ends.tolist())
+        hits = pybullet.rayTestBatch(origin.tolist(), ends.tolist(), physicsClientId=self._cid)
         frac = np.array([h[2] if h[0] >= 0 else np.inf for h in hits])
         ranges = frac * cfg.range_max
         if cfg.range_noise > 0.0:

@@ -34,7 +34,18 @@ def proc_cpu_seconds(pid: int) -> float:
     return (int(fields[11]) + int(fields[12])) / os.sysconf('SC_CLK_TCK')
 
 
-def planner_figures(seconds: float, domain: int) -> dict[str, float]:
+#: The planner node's topics beside cmd_vel, each subscribed in the "watched" run.
+VIEWS = (('markers', 'visualization_msgs.msg', 'MarkerArray'),
+         ('map', 'nav_msgs.msg', 'OccupancyGrid'), ('plan', 'nav_msgs.msg', 'Path'),
+         ('correction', 'geometry_msgs.msg', 'TransformStamped'),
+         ('status', 'std_msgs.msg', 'String'))
+
+
+def planner_figures(seconds: float, domain: int, watched: bool = False) -> dict[str, float]:
+    """The planner node's figures; ``watched``: with a subscriber on each of VIEWS (the
+    visualisation is built and sent only then)."""
+    import importlib
+
     from geometry_msgs.msg import PoseStamped, TwistStamped
     from nav_msgs.msg import Odometry
     import rclpy
@@ -42,6 +53,7 @@ def planner_figures(seconds: float, domain: int) -> dict[str, float]:
     from sensor_msgs.msg import LaserScan
 
     from ..ros.conversions import odom_to_msg, scan_to_msg
+    from ..ros.qos import LATCHED
     from ..sim.simulator import BurgerSim, SimConfig
     from ..sim.world import load_world
 
@@ -60,11 +72,19 @@ def planner_figures(seconds: float, domain: int) -> dict[str, float]:
         sent = stamp_to_seconds(msg.header.stamp)
         latencies.append(node.get_clock().now().nanoseconds * 1e-9 - sent)
     node.create_subscription(TwistStamped, 'cmd_vel', on_cmd, 10)
+    views = {name: 0 for name, _, _ in VIEWS}
+    for name, module, kind in VIEWS if watched else ():
+        qos = LATCHED if name == 'map' else 10
+        node.create_subscription(getattr(importlib.import_module(module), kind),
+                                 f'/subapf_planner/{name}',
+                                 lambda _m, n=name: views.__setitem__(n, views[n] + 1), qos)
     scan_pub = node.create_publisher(LaserScan, 'scan', qos_profile_sensor_data)
     odom_pub = node.create_publisher(Odometry, 'odom', 10)
     goal_pub = node.create_publisher(PoseStamped, 'goal_pose', 10)
     try:
-        while goal_pub.get_subscription_count() == 0 or node.count_publishers('cmd_vel') == 0:
+        while goal_pub.get_subscription_count() == 0 or node.count_publishers('cmd_vel') == 0 \
+                or any(node.count_publishers(f'/subapf_planner/{n}') == 0
+                       for n, _, _ in VIEWS if watched):
             rclpy.spin_once(node, timeout_sec=0.05)
         goal = PoseStamped()
         goal.header.frame_id = 'odom'
@@ -93,7 +113,7 @@ def planner_figures(seconds: float, domain: int) -> dict[str, float]:
     return {'cycles': cycles, 'latency_ms_median': float(np.median(ms)),
             'latency_ms_p99': float(np.percentile(ms, 99)),
             'cpu_ms_per_cycle': 1e3 * cpu / max(cycles, 1), 'rss_mib_start': rss0,
-            'rss_mib_end': rss1}
+            'rss_mib_end': rss1, 'views': views}
 
 
 def sim_node_rtf(domain: int) -> float:
@@ -150,11 +170,14 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument('--domain-id', type=int, default=None)
     args = p.parse_args(argv)
     domain = args.domain_id if args.domain_id is not None else random.randint(1, 100)
-    f = planner_figures(args.seconds, domain)
-    print(f'planner_node: {f["cycles"]} cycles; tick-to-cmd_vel latency over DDS median '
-          f'{f["latency_ms_median"]:.2f} ms, p99 {f["latency_ms_p99"]:.2f} ms; '
-          f'CPU {f["cpu_ms_per_cycle"]:.2f} ms per cycle; RSS {f["rss_mib_start"]:.1f} -> '
-          f'{f["rss_mib_end"]:.1f} MiB')
+    for watched in (False, True):
+        f = planner_figures(args.seconds, domain, watched)
+        seen = ', '.join(f'{n} {c}' for n, c in f['views'].items())
+        print(f'planner_node, {f"watched ({seen} messages)" if watched else "unwatched"}: '
+              f'{f["cycles"]} cycles; tick-to-cmd_vel latency over DDS median '
+              f'{f["latency_ms_median"]:.2f} ms, p99 {f["latency_ms_p99"]:.2f} ms; '
+              f'CPU {f["cpu_ms_per_cycle"]:.2f} ms per cycle; RSS '
+              f'{f["rss_mib_start"]:.1f} -> {f["rss_mib_end"]:.1f} MiB')
     print(f'sim_node fast mode (rate 100): real-time factor {sim_node_rtf(domain):.1f}x')
     print(f'in-process simulator + planner (fig6d): real-time factor {episode_rtf():.1f}x')
     return 0

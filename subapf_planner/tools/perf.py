@@ -4,8 +4,11 @@ Drives closed-loop episodes (sim/episode.py: the node's controller, 360-beam
 scans from the simulator) on the given worlds and prints min / median / p99 /
 max of the time per planning cycle in ms: the whole tick, i.e. with the
 geodesic default the occupancy update, the navigation field when it is
-recomputed, the APF step, the sampling and the command. Also prints the
-memory the occupancy window and the largest field hold.
+recomputed in the cycle (a new goal, the robot off the field's patch; a field that
+only brings the map's changes in is marched between cycles: core/memory.py), the
+APF step, the sampling and the command; and the time of each field computation,
+wherever it ran. Also prints the memory the occupancy window and the largest field
+hold.
 """
 
 from __future__ import annotations
@@ -70,6 +73,9 @@ def main(argv: list[str] | None = None) -> int:
         print(f'  {recomputed.sum()} cycles with a new field ({recomputed.mean():.0%}): '
               f'{_figures(ms[recomputed])}')
         print(f'  {(~recomputed).sum()} cycles without: {_figures(ms[~recomputed])}')
+        marched = np.concatenate([r.field_ms for r in runs])
+        print(f'field computations ms (wall; those that only bring map changes in run on '
+              f"the memory's worker thread between cycles): {_figures(marched)}")
     if cfg.geodesic:
         field_bytes = cells * (FIELD_BYTES_PER_BLOCK / cfg.field_coarsening ** 2
                                + FIELD_BYTES_PER_MAP_CELL)
