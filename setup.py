@@ -71,6 +71,8 @@ setup(
         ('share/ament_index/resource_index/packages', ['resource/' + PACKAGE]),
         ('share/' + PACKAGE, ['package.xml']),
         ('share/' + PACKAGE + '/config', glob('config/*.yaml') + glob('config/*.xml')),
+        ('share/' + PACKAGE + '/config/robots', glob('config/robots/*.yaml')),
+        ('share/' + PACKAGE + '/launch', glob('launch/*.launch.py')),
         ('share/' + PACKAGE + '/worlds', glob('sim/worlds/*.yaml')),
     ],
     install_requires=INSTALL_REQUIRES + ([] if os.environ.get('ROS_DISTRO') else ROS_WHEELS),

@@ -68,3 +68,12 @@ def test_yaml_lists_every_node_parameter_with_its_default():
         for f in fields:
             assert params[f.name] == f.default and type(params[f.name]) is type(f.default), \
                 f.name
+
+
+def test_robot_files_are_what_the_robot_descriptions_write():
+    from subapf_planner.core.robot import ROBOTS
+    from subapf_planner.tools.paramdoc import render_robot
+    folder = PARAMS.parent / 'robots'
+    assert {p.stem for p in folder.glob('*.yaml')} == set(ROBOTS)
+    for key in ROBOTS:
+        assert (folder / f'{key}.yaml').read_text() == render_robot(key), key

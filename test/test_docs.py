@@ -44,9 +44,9 @@ def dist_name(requirement: str) -> str:
 
 
 def imports() -> set[str]:
-    """Top-level names of every absolute import under subapf_planner/."""
+    """Top-level names of every absolute import under subapf_planner/ and launch/."""
     found = set()
-    for path in (REPO / 'subapf_planner').rglob('*.py'):
+    for path in [*(REPO / 'subapf_planner').rglob('*.py'), *(REPO / 'launch').glob('*.py')]:
         for node in ast.walk(ast.parse(path.read_text(), str(path))):
             if isinstance(node, ast.Import):
                 found |= {a.name.split('.')[0] for a in node.names}
@@ -56,8 +56,8 @@ def imports() -> set[str]:
 
 
 def is_ros(module: str) -> bool:
-    return module in ('rclpy', 'ament_index_python') or module.endswith(('_msgs',
-                                                                          '_interfaces'))
+    return module in ('rclpy', 'ament_index_python', 'launch', 'launch_ros') \
+        or module.endswith(('_msgs', '_interfaces'))
 
 
 def test_readme_has_exactly_two_fresh_machine_commands():

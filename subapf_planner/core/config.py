@@ -90,8 +90,9 @@ class PlannerConfig:
                                       'of the goal', 'm', 0.0, 10.0)
     robot_radius: float = param(BURGER.radius, 'Robot radius: half-width of the forward safety '
                                  'corridor; the field inflates obstacles by it', 'm', 0.0, 2.0)
-    safety_distance: float = param(0.18, 'Forward speed is zeroed while an obstacle point '
-                                    'lies in the corridor ahead closer than this to the centre '
+    safety_distance: float = param(BURGER.safety_distance, 'Forward speed is zeroed while an '
+                                    'obstacle point lies in the corridor ahead closer than this '
+                                    'to the centre '
                                     '(0.075 m ahead of the footprint; stopping from 0.22 m/s '
                                     'takes 0.024 m)', 'm', 0.0, 2.0)
     # --- memory and navigation-function attraction (core/occupancy.py, navigation.py) --

@@ -50,12 +50,25 @@ class RobotDescription:
     max_angular_velocity: float
     #: Height of base_link above base_footprint [m].
     base_link_height: float = 0.0
+    #: The laser's frame (its scans' frame_id) and its rated largest range [m].
+    laser_frame: str = 'base_scan'
+    laser_range: float = 3.5
+    #: Whether its base takes geometry_msgs/TwistStamped on cmd_vel (else Twist).
+    stamped_cmd_vel: bool = True
+    #: Where each number comes from.
+    source: str = ''
 
     @property
     def clearance(self) -> float:
         """Gap the local layer keeps between a laser point and the robot's centre (samples,
         DWA arcs): the footprint plus CLEARANCE_MARGIN [m]."""
         return round(self.radius + CLEARANCE_MARGIN, 6)
+
+    @property
+    def safety_distance(self) -> float:
+        """Reach of the forward safety corridor from the robot's centre: the footprint
+        plus SAFETY_MARGIN [m]."""
+        return round(self.radius + SAFETY_MARGIN, 6)
 
     @property
     def solve_radius(self) -> float:
@@ -67,6 +80,9 @@ class RobotDescription:
 #: Margin of the local layer's clearance over the footprint [m] (laser noise 0.01 m,
 #: one 0.02 m step of lag).
 CLEARANCE_MARGIN = 0.03
+#: Margin of the forward safety corridor over the footprint [m] (0.18 m for the burger:
+#: at 0.22 m/s, 0.3 s of travel).
+SAFETY_MARGIN = 0.075
 #: Margin a generated world's narrowest gap keeps over the footprint, each side [m].
 SOLVE_MARGIN = 0.05
 
@@ -77,7 +93,38 @@ SOLVE_MARGIN = 0.05
 BURGER = RobotDescription(
     name='turtlebot3_burger', radius=0.105, laser=LaserMount(-0.032, 0.0, 0.182, 0.0),
     wheel_radius=0.033, wheel_separation=0.160, max_linear_velocity=0.22,
-    max_angular_velocity=2.84, base_link_height=0.010)
+    max_angular_velocity=2.84, base_link_height=0.010, laser_frame='base_scan',
+    laser_range=3.5, stamped_cmd_vel=True,
+    source='ROBOTIS e-Manual "Specifications" (0.22 m/s, 2.84 rad/s, 138 x 178 mm); '
+    'turtlebot3_description/urdf/turtlebot3_burger.urdf (base_scan at (-0.032, 0, 0.172) '
+    'in base_link, base_link 0.010 m up; wheels 0.033 m, 0.160 m apart); Nav2 '
+    'robot_radius 0.105 m of the turtlebot3 package; LDS-01 0.12-3.5 m (an LDS-02 '
+    'burger: 0.16-8 m, set obstacle_range); Jazzy turtlebot3_node takes TwistStamped')
+#: TurtleBot3 Waffle Pi (and the discontinued Waffle: same base, limits and laser).
+WAFFLE_PI = RobotDescription(
+    name='turtlebot3_waffle_pi', radius=0.24, laser=LaserMount(-0.064, 0.0, 0.131, 0.0),
+    wheel_radius=0.033, wheel_separation=0.288, max_linear_velocity=0.26,
+    max_angular_velocity=1.82, base_link_height=0.010, laser_frame='base_scan',
+    laser_range=3.5, stamped_cmd_vel=True,
+    source='ROBOTIS e-Manual "Specifications" (0.26 m/s, 1.82 rad/s, 281 x 306 mm); '
+    'turtlebot3_description/urdf/turtlebot3_waffle_pi.urdf.xacro (base_scan at '
+    '(-0.064, 0, 0.121) in base_link, base_link 0.010 m up; wheels 0.033 m, 0.288 m '
+    'apart; body box 0.266 m square centred 0.064 m behind the axle: its rear corners '
+    '0.238 m from base_footprint, hence the 0.24 m radius); LDS-01 0.12-3.5 m')
+#: TurtleBot 4 (standard and lite: an iRobot Create 3 base with an RPLIDAR A1M8).
+TURTLEBOT4 = RobotDescription(
+    name='turtlebot4', radius=0.175, laser=LaserMount(-0.04, 0.0, 0.193, math.pi / 2),
+    wheel_radius=0.03575, wheel_separation=0.233, max_linear_velocity=0.26,
+    max_angular_velocity=1.0, base_link_height=0.0, laser_frame='rplidar_link',
+    laser_range=12.0, stamped_cmd_vel=True,
+    source='turtlebot4_navigation/config/nav2.yaml for Jazzy (robot_radius 0.175 m; '
+    'velocity_smoother max_velocity 0.26 m/s, 1.0 rad/s; enable_stamped_cmd_vel true); '
+    'turtlebot4_description/urdf/standard/turtlebot4.urdf.xacro (rplidar_link 0.04 m '
+    'behind base_link, turned by +pi/2, about 0.193 m up); irobot_create_description '
+    '(body radius 0.164 m, wheels 0.03575 m, 0.233 m apart; base_link on the ground: '
+    'it is the base frame); RPLIDAR A1M8 0.15-12 m')
+#: The robots config/robots/ has a parameter file for, by file name.
+ROBOTS = {'burger': BURGER, 'waffle_pi': WAFFLE_PI, 'turtlebot4': TURTLEBOT4}
 
 
 def compose(parent: ArrayLike, child: ArrayLike) -> tuple[float, float, float]:

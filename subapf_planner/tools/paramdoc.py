@@ -1,15 +1,20 @@
-"""``config/planner.yaml`` written from the parameter dataclasses' metadata.
+"""``config/planner.yaml`` and ``config/robots/*.yaml`` written from the code.
 
-The file documents every parameter of both nodes (default, unit, range or
+``planner.yaml`` documents every parameter of both nodes (default, unit, range or
 choices, read-only) and is the params file the nodes, ``subapf-bench`` and
-``subapf-replay`` read; ``test/test_config.py`` checks the committed file equals
-what :func:`render` writes, so it cannot drift from the code. Regenerate with
-``python -m subapf_planner.tools.paramdoc config/planner.yaml``.
+``subapf-replay`` read. Each robot file holds the planner node's parameters that
+come from one robot (core/robot.py ROBOTS: footprint and the clearances derived
+from it, laser mounting, frame and range, limits, cmd_vel type), loaded after
+planner.yaml. ``test/test_config.py`` checks the committed files equal what
+:func:`render` and :func:`render_robot` write, so they cannot drift from the code.
+Regenerate with ``python -m subapf_planner.tools.paramdoc config/planner.yaml
+config/robots``.
 """
 
 from __future__ import annotations
 
 import dataclasses
+from pathlib import Path
 import sys
 import textwrap
 
@@ -17,6 +22,7 @@ import yaml
 
 from ..core.config import PlannerConfig
 from ..core.loop import Supervision
+from ..core.robot import ROBOTS, RobotDescription
 from ..sim.faults import ScanFaults
 from ..sim.simulator import SimConfig
 
@@ -68,7 +74,44 @@ def render() -> str:
     return HEADER + '\n'.join(planner + [''] + sim) + '\n'
 
 
+def robot_parameters(robot: RobotDescription) -> dict[str, float | str | bool]:
+    """The planner node's parameters that come from ``robot``: the footprint and the
+    clearances derived from it, the laser's mounting, frame and range (at most half
+    the occupancy window: a return beyond it has no cell), the limits, cmd_vel type."""
+    half_window = PlannerConfig().map_size / 2
+    return {
+        'laser_frame': robot.laser_frame, 'enable_stamped_cmd_vel': robot.stamped_cmd_vel,
+        'robot_radius': robot.radius, 'inflation_radius': robot.radius,
+        'sample_clearance': robot.clearance, 'dwa_clearance': robot.clearance,
+        'safety_distance': robot.safety_distance,
+        'laser_x': robot.laser.x, 'laser_y': robot.laser.y,
+        'laser_yaw': round(robot.laser.yaw, 6),
+        'obstacle_range': min(robot.laser_range, half_window),
+        'max_linear_velocity': robot.max_linear_velocity,
+        'max_angular_velocity': robot.max_angular_velocity,
+    }
+
+
+def render_robot(key: str) -> str:
+    """The parameter file of ``ROBOTS[key]``."""
+    robot = ROBOTS[key]
+    lines = [f'# {robot.name}: the planner node parameters that come from the robot,',
+             '# written by `python -m subapf_planner.tools.paramdoc config/planner.yaml '
+             'config/robots`', '# from core/robot.py. Load after planner.yaml:',
+             f'#   --params-file config/planner.yaml --params-file config/robots/{key}.yaml',
+             f'#   (or launch/planner.launch.py robot:={key}).',
+             *textwrap.wrap('Sources: ' + robot.source + '.', 86, initial_indent='# ',
+                            subsequent_indent='#   '),
+             'subapf_planner:', '  ros__parameters:']
+    for name, value in robot_parameters(robot).items():
+        lines.append('    ' + yaml.safe_dump({name: value}, default_flow_style=True,
+                                              width=200).strip()[1:-1])
+    return '\n'.join(lines) + '\n'
+
+
 def main(argv: list[str] | None = None) -> int:
+    """``paramdoc [planner.yaml [robots/]]``: the params file (stdout without a path)
+    and the robot files in the folder."""
     argv = sys.argv[1:] if argv is None else argv
     text = render()
     if argv:
@@ -76,6 +119,11 @@ def main(argv: list[str] | None = None) -> int:
             out.write(text)
     else:
         sys.stdout.write(text)
+    if len(argv) > 1:
+        folder = Path(argv[1])
+        folder.mkdir(parents=True, exist_ok=True)
+        for key in ROBOTS:
+            (folder / f'{key}.yaml').write_text(render_robot(key))
     return 0
 
 

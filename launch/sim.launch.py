@@ -1,0 +1,45 @@
+"""The headless simulator and the planner on its clock:
+``ros2 launch subapf_planner sim.launch.py world:=<world file> rate:=1.0``.
+
+sim_node (the PyBullet burger stand-in) publishes /clock, scan, odom and the run's
+outcome; planner.launch.py's planner runs on that clock with the burger's config (the
+stand-in is a burger). Send a goal on goal_pose (RViz "2D Goal Pose", frame odom);
+subapf-bringup does all this in one process tree and sends the world's goal itself.
+"""
+
+from launch import LaunchDescription
+from launch.actions import DeclareLaunchArgument, IncludeLaunchDescription
+from launch.launch_description_sources import PythonLaunchDescriptionSource
+from launch.substitutions import LaunchConfiguration, PathJoinSubstitution
+from launch_ros.actions import Node
+from launch_ros.substitutions import FindPackageShare
+
+PACKAGE = 'subapf_planner'
+
+
+def generate_launch_description() -> LaunchDescription:
+    share = FindPackageShare(PACKAGE)
+    return LaunchDescription([
+        DeclareLaunchArgument(
+            'world', default_value=PathJoinSubstitution([share, 'worlds',
+                                                         'fig6d_big_wall.yaml']),
+            description='World file (format v1 YAML; the shipped ones are in share/worlds)'),
+        DeclareLaunchArgument('rate', default_value='1.0',
+                              description='Simulated seconds per wall-clock second'),
+        Node(
+            package=PACKAGE,
+            executable='sim_node',
+            name='subapf_sim',
+            output='screen',
+            parameters=[
+                PathJoinSubstitution([share, 'config', 'planner.yaml']),
+                {'world': LaunchConfiguration('world'),
+                 'rate': LaunchConfiguration('rate')},
+            ],
+        ),
+        IncludeLaunchDescription(
+            PythonLaunchDescriptionSource(
+                PathJoinSubstitution([share, 'launch', 'planner.launch.py'])),
+            launch_arguments={'robot': 'burger', 'use_sim_time': 'true'}.items(),
+        ),
+    ])
