@@ -213,17 +213,27 @@ class PlannerConfig:
         """The defaults for ``robot``: its footprint, laser mounting and limits, and the
         clearances derived from its footprint (inflation, samples, DWA); ``changes`` on
         top (validated)."""
-        mount = robot.laser
-        return from_mapping({
-            'robot_radius': robot.radius, 'inflation_radius': robot.radius,
-            'sample_clearance': robot.clearance, 'dwa_clearance': robot.clearance,
-            'laser_x': mount.x, 'laser_y': mount.y, 'laser_yaw': mount.yaw,
-            'max_linear_velocity': robot.max_linear_velocity,
-            'max_angular_velocity': robot.max_angular_velocity, **changes})
+        return from_mapping({**robot_fields(robot), **changes})
 
     def replace(self, **changes: Any) -> 'PlannerConfig':
         """Copy with some fields changed (validated)."""
         return from_mapping({**dataclasses.asdict(self), **changes})
+
+
+def robot_fields(robot: RobotDescription) -> dict[str, float]:
+    """The PlannerConfig fields that come from ``robot``: its footprint and the clearances
+    derived from it (inflation, samples, DWA, the safety corridor), its laser's mounting
+    and range (at most half the default occupancy window: a return beyond it has no
+    cell), its limits."""
+    mount = robot.laser
+    return {
+        'robot_radius': robot.radius, 'inflation_radius': robot.radius,
+        'sample_clearance': robot.clearance, 'dwa_clearance': robot.clearance,
+        'safety_distance': robot.safety_distance,
+        'laser_x': mount.x, 'laser_y': mount.y, 'laser_yaw': round(mount.yaw, 6),
+        'obstacle_range': min(robot.laser_range, PlannerConfig.map_size / 2),
+        'max_linear_velocity': robot.max_linear_velocity,
+        'max_angular_velocity': robot.max_angular_velocity}
 
 
 def field_specs() -> list[dataclasses.Field]:

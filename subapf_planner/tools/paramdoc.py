@@ -20,7 +20,7 @@ import textwrap
 
 import yaml
 
-from ..core.config import PlannerConfig
+from ..core.config import PlannerConfig, robot_fields
 from ..core.loop import Supervision
 from ..core.robot import ROBOTS, RobotDescription
 from ..sim.faults import ScanFaults
@@ -75,21 +75,10 @@ def render() -> str:
 
 
 def robot_parameters(robot: RobotDescription) -> dict[str, float | str | bool]:
-    """The planner node's parameters that come from ``robot``: the footprint and the
-    clearances derived from it, the laser's mounting, frame and range (at most half
-    the occupancy window: a return beyond it has no cell), the limits, cmd_vel type."""
-    half_window = PlannerConfig().map_size / 2
-    return {
-        'laser_frame': robot.laser_frame, 'enable_stamped_cmd_vel': robot.stamped_cmd_vel,
-        'robot_radius': robot.radius, 'inflation_radius': robot.radius,
-        'sample_clearance': robot.clearance, 'dwa_clearance': robot.clearance,
-        'safety_distance': robot.safety_distance,
-        'laser_x': robot.laser.x, 'laser_y': robot.laser.y,
-        'laser_yaw': round(robot.laser.yaw, 6),
-        'obstacle_range': min(robot.laser_range, half_window),
-        'max_linear_velocity': robot.max_linear_velocity,
-        'max_angular_velocity': robot.max_angular_velocity,
-    }
+    """The planner node's parameters that come from ``robot``: its laser's frame, its
+    cmd_vel type and core/config.py's robot_fields."""
+    return {'laser_frame': robot.laser_frame, 'enable_stamped_cmd_vel': robot.stamped_cmd_vel,
+            **robot_fields(robot)}
 
 
 def render_robot(key: str) -> str:
