@@ -214,11 +214,11 @@ def test_planner_stops_for_an_enclosed_goal_and_drives_when_it_opens():
     assert res.command.status is not Status.GOAL_UNREACHABLE
 
 
-def test_memory_recomputes_on_a_new_goal_and_at_most_every_field_period():
-    cfg = PlannerConfig(field_period=1.0)
+def _first_fields(cfg: PlannerConfig) -> NavigationMemory:
+    """A memory that computed a field, kept it while the map changed within
+    field_period, and computed one for a new goal at 0.4 s."""
     mem = NavigationMemory(cfg)
-    ranges, amin, inc, rmin, rmax = enclosure_scan(2.0)
-    mem.integrate(Scan(ranges, amin, inc, rmin, rmax, 0.0), (0.0, 0.0, 0.0))
+    mem.integrate(Scan(*enclosure_scan(2.0), 0.0), (0.0, 0.0, 0.0))
     mem.field_for((0, 0), (1.0, 0.0), now=0.0)
     assert mem.recomputed
     mem.integrate(Scan(*enclosure_scan(1.5), 0.2), (0.0, 0.0, 0.0))
@@ -227,6 +227,21 @@ def test_memory_recomputes_on_a_new_goal_and_at_most_every_field_period():
     mem.field_for((0, 0), (0.0, 1.0), now=0.4)
     assert mem.recomputed                        # new goal
     mem.integrate(Scan(*enclosure_scan(1.2), 1.5), (0.0, 0.0, 0.0))
+    return mem
+
+
+def test_memory_recomputes_on_a_new_goal_and_at_most_every_field_period():
+    mem = _first_fields(PlannerConfig(field_period=1.0))
+    mem.field_for((0, 0), (0.0, 1.0), now=1.5)
+    assert mem.recomputed                        # grid changed, field_period over
+    mem.integrate(Scan(*enclosure_scan(1.2), 3.0), (0.0, 0.0, 0.0))
+    mem.field_for((0, 0), (0.0, 1.0), now=3.0)
+    assert not mem.recomputed                    # the same walls seen again: no change
+
+
+def test_with_the_worker_the_map_changes_reach_the_field_at_the_next_call():
+    cfg = PlannerConfig(field_period=1.0, field_worker=True)
+    mem = _first_fields(cfg)
     before = mem.field
     assert mem.field_for((0, 0), (0.0, 1.0), now=1.5) is before   # grid changed, period
     assert not mem.recomputed                    # over: marched in the worker ...
@@ -237,13 +252,10 @@ def test_memory_recomputes_on_a_new_goal_and_at_most_every_field_period():
     for r, t in ((2.0, 0.0), (1.5, 0.2), (1.2, 1.5)):
         alone.integrate(Scan(*enclosure_scan(r), t), (0.0, 0.0, 0.0))
     np.testing.assert_array_equal(alone.field_for((0, 0), (0.0, 1.0)).values, after.values)
-    mem.integrate(Scan(*enclosure_scan(1.2), 3.0), (0.0, 0.0, 0.0))
-    mem.field_for((0, 0), (0.0, 1.0), now=3.0)
-    assert not mem.recomputed                    # the same walls seen again: no change
 
 
 def test_a_field_being_marched_is_dropped_for_a_new_goal_or_a_forgotten_map():
-    mem = NavigationMemory(PlannerConfig(field_period=1.0))
+    mem = NavigationMemory(PlannerConfig(field_period=1.0, field_worker=True))
     mem.integrate(Scan(*enclosure_scan(2.0), 0.0), (0.0, 0.0, 0.0))
     mem.field_for((0, 0), (1.0, 0.0), now=0.0)
     mem.integrate(Scan(*enclosure_scan(1.5), 1.2), (0.0, 0.0, 0.0))

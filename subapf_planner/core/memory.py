@@ -7,14 +7,15 @@ the field covers, or, when the occupied cells changed, at most every
 core/navigation.py). A scan that only confirms what the map holds changes no
 occupied cell and costs no field.
 
-A field that is needed at once (a new goal, a place avoided or opened again, the
-robot off the patch, no field yet) is computed in the cycle. One that only brings
-the map's changes in is marched on a worker thread from the cycle's map, while
-the cycle goes on with the field it has, and is taken at the next call (waited
-for if it is not done yet): the same calls give the same fields whatever the
-timing (the bench, the replay and the node agree), and a planning tick no longer
-waits for the marching (a node's thread is idle between ticks; the marching
-holds the GIL, so it takes no time from anything but that idle time).
+With ``field_worker`` (off by default), a field that only brings the map's changes
+in is marched on a worker thread from the cycle's map, while the cycle goes on
+with the field it has, and is taken at the next call (waited for if it is not
+done yet); a field needed at once (a new goal, a place avoided or opened again,
+the robot off the patch, no field yet) is still computed in the cycle. The same
+calls give the same fields whatever the timing (the bench, the replay and the
+node agree), and a planning tick does not wait for the marching (a node's thread
+is idle between ticks; the marching holds the GIL, so it takes no time from
+anything but that idle time).
 """
 
 from __future__ import annotations
@@ -261,7 +262,8 @@ class NavigationMemory:
         covered = self.field is None or self._covers(p)
         if fresh and covered:
             return self.field
-        if same_goal and covered and self.field is not None and now is not None:
+        if self.cfg.field_worker and same_goal and covered and self.field is not None \
+                and now is not None:
             self._march_later(g, p, now)   # only the map's changes: the next call has it
             return self.field
         self._install(self._compute(self._blocked(now), self.grid.origin, g, p), key,
