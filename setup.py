@@ -70,7 +70,8 @@ setup(
     data_files=[
         ('share/ament_index/resource_index/packages', ['resource/' + PACKAGE]),
         ('share/' + PACKAGE, ['package.xml']),
-        ('share/' + PACKAGE + '/config', glob('config/*.yaml') + glob('config/*.xml')),
+        ('share/' + PACKAGE + '/config',
+         glob('config/*.yaml') + glob('config/*.xml') + glob('config/*.rviz')),
         ('share/' + PACKAGE + '/config/robots', glob('config/robots/*.yaml')),
         ('share/' + PACKAGE + '/launch', glob('launch/*.launch.py')),
         ('share/' + PACKAGE + '/worlds', glob('sim/worlds/*.yaml')),

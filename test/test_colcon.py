@@ -67,6 +67,7 @@ def test_colcon_build_installs_ros2_run_executables(tmp_path):
     assert Path(lines[0]) == prefix
     share = Path(lines[1])
     assert (share / 'config' / 'planner.yaml').is_file()
+    assert (share / 'config' / 'subapf.rviz').is_file()
     assert len(list((share / 'worlds').glob('*.yaml'))) >= 8
     # what `ros2 launch subapf_planner <file>` and the robot configs need
     assert {p.name for p in (share / 'launch').iterdir()} == {'planner.launch.py',

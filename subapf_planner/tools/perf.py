@@ -74,8 +74,9 @@ def main(argv: list[str] | None = None) -> int:
               f'{_figures(ms[recomputed])}')
         print(f'  {(~recomputed).sum()} cycles without: {_figures(ms[~recomputed])}')
         marched = np.concatenate([r.field_ms for r in runs])
-        print(f'field computations ms (wall; those that only bring map changes in run on '
-              f"the memory's worker thread between cycles): {_figures(marched)}")
+        where = ("; those that only bring the map's changes in ran on the memory's worker "
+                 'thread between cycles') if cfg.field_worker else ', all in their cycle'
+        print(f'field computations ms (wall{where}): {_figures(marched)}')
     if cfg.geodesic:
         field_bytes = cells * (FIELD_BYTES_PER_BLOCK / cfg.field_coarsening ** 2
                                + FIELD_BYTES_PER_MAP_CELL)
