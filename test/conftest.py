@@ -168,3 +168,24 @@ def pytest_collection_modifyitems(config, items):
     if required:
         raise pytest.UsageError(message)
     warnings.warn(pytest.PytestWarning(message), stacklevel=1)
+
+
+@pytest.fixture(scope='session')
+def tf2_msgs_built() -> dict[str, str]:
+    """PYTHONPATH and LD_LIBRARY_PATH for a process to import tf2_msgs: the ROS
+    install's when there is one, else test/tf2_msgs_pkg built once (test/tf_build.py)."""
+    try:
+        from tf2_msgs.msg import TFMessage  # noqa: F401
+        return {}
+    except ImportError:
+        from tf_build import tf2_msgs_env
+        env = tf2_msgs_env({})
+        return {k: env[k] for k in ('PYTHONPATH', 'LD_LIBRARY_PATH')}
+
+
+def with_paths(env: dict[str, str], paths: dict[str, str]) -> dict[str, str]:
+    """``env`` with ``paths`` (PYTHONPATH-like variables) put in front."""
+    out = dict(env)
+    for k, v in paths.items():
+        out[k] = os.pathsep.join(filter(None, [v, env.get(k)]))
+    return out

@@ -88,3 +88,20 @@ def test_round_trips():
     scan = scan_from_msg(scan_to_msg(Scan(ranges, -0.1, 0.01, 0.12, 3.5, 4.0), 'base_scan'))
     np.testing.assert_array_equal(scan.ranges, ranges.astype(np.float32))
     assert scan.stamp == pytest.approx(4.0) and scan.angle_increment == pytest.approx(0.01)
+
+
+def test_planar_transform_gives_the_planar_part_and_whether_it_is_level():
+    import math
+
+    from subapf_planner.ros.conversions import planar_transform, transform_msg
+    t = transform_msg('base_link', 'laser', (0.1, -0.2, 0.3), 1.2, 0.0)
+    parent, child, pose, level = planar_transform(t)
+    assert (parent, child, level) == ('base_link', 'laser', True)
+    assert pose == pytest.approx((0.1, -0.2, 1.2))
+    t.transform.rotation.x, t.transform.rotation.y, t.transform.rotation.z, \
+        t.transform.rotation.w = 1.0, 0.0, 0.0, 0.0   # upside down (roll pi)
+    assert planar_transform(t)[3] is False
+    s = math.sin(0.01)   # a hundredth of a radian of pitch is level
+    t.transform.rotation.x, t.transform.rotation.y, t.transform.rotation.z, \
+        t.transform.rotation.w = 0.0, s, 0.0, math.cos(0.01)
+    assert planar_transform(t)[3] is True

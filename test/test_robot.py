@@ -92,3 +92,18 @@ def test_compose_and_to_parent_agree(a, b, p):
     direct = to_parent(compose(a, b), [p])
     np.testing.assert_allclose(through, direct, atol=1e-9)
     np.testing.assert_allclose(to_parent(a, [(0.0, 0.0)])[0], a[:2], atol=1e-12)
+
+
+def test_chain_composes_the_links_from_the_base_to_the_leaf():
+    from subapf_planner.core.robot import chain
+    links = {'base_link': ('base_footprint', (0.0, 0.0, 0.0)),
+             'base_scan': ('base_link', (-0.032, 0.0, 0.0)),
+             'turned': ('base_scan', (0.1, 0.0, math.pi / 2)),
+             'tip': ('turned', (0.1, 0.0, 3.0))}
+    assert chain(links, 'base_footprint', 'base_scan') == pytest.approx((-0.032, 0.0, 0.0))
+    x, y, yaw = chain(links, 'base_footprint', 'tip')
+    assert (x, y) == pytest.approx((0.068, 0.1)) and yaw == pytest.approx(
+        math.remainder(math.pi / 2 + 3.0, 2 * math.pi))
+    assert chain(links, 'base_footprint', 'base_footprint') == (0.0, 0.0, 0.0)
+    assert chain(links, 'odom', 'base_scan') is None          # not connected
+    assert chain({'a': ('b', (0, 0, 0)), 'b': ('a', (0, 0, 0))}, 'c', 'a') is None   # a loop

@@ -31,7 +31,8 @@ def test_each_robot_file_configures_the_node(key):
         assert cfg.max_linear_velocity == robot.max_linear_velocity
         assert cfg.max_angular_velocity == robot.max_angular_velocity
         assert cfg.obstacle_range == min(robot.laser_range, cfg.map_size / 2)
-        assert options.laser_frame == robot.laser_frame
+        assert (options.base_frame, options.laser_frame) == (robot.base_frame,
+                                                             robot.laser_frame)
         assert options.enable_stamped_cmd_vel == robot.stamped_cmd_vel
         node.destroy_node()
     finally:

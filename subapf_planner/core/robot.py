@@ -14,6 +14,7 @@ places a pose is applied.
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass
 import math
 
@@ -50,7 +51,9 @@ class RobotDescription:
     max_angular_velocity: float
     #: Height of base_link above base_footprint [m].
     base_link_height: float = 0.0
-    #: The laser's frame (its scans' frame_id) and its rated largest range [m].
+    #: The frame odometry gives the pose of (REP-105: base_footprint), and the laser's
+    #: frame (its scans' frame_id) and rated largest range [m].
+    base_frame: str = 'base_footprint'
     laser_frame: str = 'base_scan'
     laser_range: float = 3.5
     #: Whether its base takes geometry_msgs/TwistStamped on cmd_vel (else Twist).
@@ -115,7 +118,8 @@ WAFFLE_PI = RobotDescription(
 TURTLEBOT4 = RobotDescription(
     name='turtlebot4', radius=0.175, laser=LaserMount(-0.04, 0.0, 0.193, math.pi / 2),
     wheel_radius=0.03575, wheel_separation=0.233, max_linear_velocity=0.26,
-    max_angular_velocity=1.0, base_link_height=0.0, laser_frame='rplidar_link',
+    max_angular_velocity=1.0, base_link_height=0.0, base_frame='base_link',
+    laser_frame='rplidar_link',
     laser_range=12.0, stamped_cmd_vel=True,
     source='turtlebot4_navigation/config/nav2.yaml for Jazzy (robot_radius 0.175 m; '
     'velocity_smoother max_velocity 0.26 m/s, 1.0 rad/s; enable_stamped_cmd_vel true); '
@@ -152,3 +156,22 @@ def to_parent(pose: ArrayLike, points: ArrayLike) -> NDArray[np.float64]:
     p = np.asarray(points, float).reshape(-1, 2)
     c, s = math.cos(yaw), math.sin(yaw)
     return np.column_stack((x + c * p[:, 0] - s * p[:, 1], y + s * p[:, 0] + c * p[:, 1]))
+
+
+def chain(links: Mapping[str, tuple[str, tuple[float, float, float]]], base: str,
+          leaf: str, max_links: int = 32) -> tuple[float, float, float] | None:
+    """The planar pose (x, y, yaw) of frame ``leaf`` in frame ``base`` from ``links``
+    (child -> (parent, its pose in the parent)), walking from ``leaf`` up through its
+    parents; None when ``base`` is not among them (or the links loop). The yaw is
+    wrapped to [-pi, pi]."""
+    poses = []
+    frame = leaf
+    while frame != base:
+        if frame not in links or len(poses) >= max_links:
+            return None
+        frame, pose = links[frame]
+        poses.append(pose)
+    out = (0.0, 0.0, 0.0)
+    for pose in reversed(poses):
+        out = compose(out, pose)
+    return (out[0], out[1], math.remainder(out[2], 2.0 * math.pi))

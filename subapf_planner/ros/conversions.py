@@ -103,6 +103,25 @@ def transform_msg(parent: str, child: str, xyz: tuple[float, float, float], yaw:
     return t
 
 
+#: Roll or pitch beyond this and a transform is not level: a 2-D laser tilted (or
+#: mounted upside down) is not what laser_x, laser_y, laser_yaw describe [rad].
+LEVEL_TOLERANCE = 0.05
+
+
+def planar_transform(t: TransformStamped) -> tuple[str, str, tuple[float, float, float],
+                                                   bool]:
+    """(parent, child, (x, y, yaw), level) of a transform: its planar part, and whether
+    its roll and pitch are within LEVEL_TOLERANCE."""
+    q = t.transform.rotation
+    x, y, z, w = q.x, q.y, q.z, q.w
+    roll = math.atan2(2.0 * (w * x + y * z), 1.0 - 2.0 * (x * x + y * y))
+    pitch = math.asin(max(-1.0, min(1.0, 2.0 * (w * y - z * x))))
+    yaw = math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
+    v = t.transform.translation
+    level = abs(roll) <= LEVEL_TOLERANCE and abs(pitch) <= LEVEL_TOLERANCE
+    return t.header.frame_id, t.child_frame_id, (float(v.x), float(v.y), yaw), level
+
+
 def cmd_to_msg(v: float, w: float, stamped: bool, stamp: Time | None = None,
                frame_id: str = 'base_link') -> Twist | TwistStamped:
     twist = Twist()

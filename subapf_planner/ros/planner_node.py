@@ -44,8 +44,8 @@ from ..core.config import ConfigError, PlannerConfig
 from ..core.loop import DecisionLoop, Supervision
 from ..core.navigation import thin_polyline
 from ..core.params import check_fields, param
-from ..core.robot import invert, to_parent
-from .conversions import cmd_to_msg, grid_to_msg, path_to_msg, transform_msg
+from ..core.robot import chain, invert, to_parent
+from .conversions import cmd_to_msg, grid_to_msg, path_to_msg, planar_transform, transform_msg
 from .intake import Intake
 from .markers import markers_from_result
 from .parameters import declare, read
@@ -90,6 +90,9 @@ class NodeOptions:
                                'when the robot moved 0.25 m or a second passed, while '
                                'something subscribes')
     laser_frame: str = param('base_scan', 'Expected scan frame_id; empty accepts any')
+    base_frame: str = param('base_footprint', "The robot's base frame: the laser mounting is "
+                            'read from /tf_static as this frame -> laser_frame when it is '
+                            'there (else laser_x, laser_y, laser_yaw)', read_only=True)
     odom_frame: str = param('odom', 'Frame of odometry and goals')
     map_frame: str = param('map', "Name of the memory's frame (odom as it was at the start, "
                            'kept still by scan_alignment): goals may be given in it, and '
@@ -138,6 +141,11 @@ class PlannerNode(Node):
              self._on_odom))
         self.create_subscription(PoseStamped, 'goal_pose', self._on_goal, 10)
 
+        #: /tf_static so far: child -> (parent, planar pose, level); the mounting read
+        #: from it (None: the parameters').
+        self._links: dict[str, tuple[str, tuple[float, float, float], bool]] = {}
+        self._tf_mount: tuple[float, float, float] | None = None
+        self._setup_tf_static()
         self._last_state = ''
         if self.options.goal_from_parameters:
             self._set_goal(np.array([self.options.goal_x, self.options.goal_y]))
@@ -175,8 +183,54 @@ class PlannerNode(Node):
             self.timer.timer_period_ns = int(cfg.period * 1e9)
         self.options = pending[NodeOptions]
         self.intake = self._intake()
-        self.ctl.cfg = cfg
+        self.ctl.cfg = self._mounted(cfg)
         self.ctl.limits = pending[Supervision]
+
+    # --- the laser mounting from /tf_static --------------------------------------------
+    def _setup_tf_static(self) -> None:
+        o = self.options
+        try:
+            from tf2_msgs.msg import TFMessage
+        except ImportError:
+            self.get_logger().info(f'laser mounting from parameters {self.ctl.cfg.laser_mount}'
+                                   ' (tf2_msgs not installed: /tf_static not read)')
+            return
+        self.create_subscription(TFMessage, '/tf_static', self._on_tf_static, LATCHED)
+        self.get_logger().info(f'laser mounting from parameters {self.ctl.cfg.laser_mount} '
+                               f'until /tf_static gives {o.base_frame} -> {o.laser_frame}')
+
+    def _on_tf_static(self, msg) -> None:
+        for t in msg.transforms:
+            parent, child, pose, level = planar_transform(t)
+            self._links[child] = (parent, pose, level)
+        o = self.options
+        links = {c: (p, pose) for c, (p, pose, _) in self._links.items()}
+        mount = chain(links, o.base_frame, o.laser_frame) if o.laser_frame else None
+        if mount is None or mount == self._tf_mount:
+            return
+        tilted, frame = [], o.laser_frame   # the links of the chain (it ends: found)
+        while frame != o.base_frame:
+            parent, _, level = self._links[frame]
+            if not level:
+                tilted.append(frame)
+            frame = parent
+        if tilted:
+            self.get_logger().warn(f'/tf_static: {", ".join(tilted)} not level: laser '
+                                   f'mounting kept from parameters {self.ctl.cfg.laser_mount}')
+            return
+        self._tf_mount = mount
+        self.ctl.cfg = self._mounted(self.ctl.cfg)
+        self.get_logger().info(
+            f'laser mounting from /tf_static ({o.base_frame} -> {o.laser_frame}): '
+            f'x={mount[0]:.3f} m y={mount[1]:.3f} m yaw={mount[2]:.3f} rad '
+            '(laser_x, laser_y, laser_yaw not used)')
+
+    def _mounted(self, cfg: PlannerConfig) -> PlannerConfig:
+        """``cfg`` with the mounting /tf_static gave, if it gave one."""
+        if self._tf_mount is None:
+            return cfg
+        x, y, yaw = self._tf_mount
+        return cfg.replace(laser_x=x, laser_y=y, laser_yaw=yaw)
 
     def _on_clock_jump(self, jump) -> None:
         self.get_logger().warn(f'clock jumped by {jump.delta.nanoseconds * 1e-9:+.2f} s '

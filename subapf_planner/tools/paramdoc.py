@@ -75,10 +75,10 @@ def render() -> str:
 
 
 def robot_parameters(robot: RobotDescription) -> dict[str, float | str | bool]:
-    """The planner node's parameters that come from ``robot``: its laser's frame, its
-    cmd_vel type and core/config.py's robot_fields."""
-    return {'laser_frame': robot.laser_frame, 'enable_stamped_cmd_vel': robot.stamped_cmd_vel,
-            **robot_fields(robot)}
+    """The planner node's parameters that come from ``robot``: its base and laser
+    frames, its cmd_vel type and core/config.py's robot_fields."""
+    return {'base_frame': robot.base_frame, 'laser_frame': robot.laser_frame,
+            'enable_stamped_cmd_vel': robot.stamped_cmd_vel, **robot_fields(robot)}
 
 
 def render_robot(key: str) -> str:
