@@ -283,16 +283,16 @@ def test_views_are_built_only_while_something_subscribes(harness, monkeypatch):
 def test_scans_and_odometry_are_taken_at_the_tick_not_by_the_executor(harness):
     """The inputs' subscriptions are in a group the executor never runs (PolledGroup):
     a scan and odometry that arrived wait in their queues until the planning tick."""
-    h = harness(planning_frequency=1.0)
+    h = harness(planning_frequency=0.5)
     h.goal(3.0, 0.0)
-    assert h.spin_until(lambda: any(s.startswith('waiting') for s in h.states))
-    for _ in range(3):   # just after a tick: the next is a second away
+    assert h.spin_until(lambda: any(s.startswith('waiting') for s in h.states), timeout=8.0)
+    for _ in range(3):   # just after a tick: the next is two seconds away
         h.feed()
     polled = [sub for sub, _ in h.node._inputs]
     assert all(not sub.callback_group.can_execute(sub) for sub in polled)
-    h.spin_until(lambda: False, timeout=0.3)   # the executor ran, the 1 Hz tick did not
+    h.spin_until(lambda: False, timeout=0.3)   # the executor ran, the 0.5 Hz tick did not
     assert h.node.ctl.scan is None and h.node.ctl.pose is None
-    assert h.spin_until(lambda: bool(h.cmds), timeout=3.0)   # the tick took them in
+    assert h.spin_until(lambda: bool(h.cmds), timeout=5.0)   # the tick took them in
     assert h.node.ctl.scan is not None and h.node.ctl.pose is not None
 
 
