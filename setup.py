@@ -38,6 +38,7 @@ INSTALL_REQUIRES = [
     'pyyaml>=6',
     'tqdm>=4.66',
     'scikit-fmm>=2024.5',
+    'distributed>=2024.1',   # subapf-bench --cluster (Dask)
 ]
 
 # Which names the console scripts get. The bare names (planner_node, bench, perf, ...)

@@ -81,3 +81,44 @@ def test_every_default_method_is_drawn_its_own_way():
     assert len({text for _, _, text in styles}) == len(DEFAULT_METHODS)
     assert method_style('subharmonic_sampling:geodesic')[1] == '-'
     assert method_style('subharmonic_sampling:euclidean')[1] == '--'
+
+
+#: What results.json may differ in between two runs of the same bench: wall-clock times.
+TIMING = {'wall_time_s', 'plan_ms_median', 'plan_ms_p99'}
+
+
+def without_timing(doc: dict) -> dict:
+    return {k: ([{f: v for f, v in r.items() if f not in TIMING} for r in doc['runs']]
+                if k == 'runs' else v) for k, v in doc.items() if k not in TIMING}
+
+
+def test_a_bench_on_a_dask_cluster_gives_the_results_of_local_jobs(tmp_path, worlds_dir):
+    """--cluster (a local 2-worker Dask cluster here; a scheduler on another machine is
+    the same) writes the results.json of --jobs 2, field for field but the timings,
+    and draws the plots here."""
+    from distributed import LocalCluster
+    worlds = [str(worlds_dir / name) for name in ('four_points.yaml',
+                                                   'fig6c_circle_in_front.yaml',
+                                                   'fig6d_big_wall.yaml')]
+    methods = ['--methods', 'subharmonic_sampling,subharmonic_sampling:euclidean,'
+               'dwa:euclidean', '--seed', '3', '--odom-scale', '1.01']
+    assert main(worlds + methods + ['--jobs', '2', '--no-plots',
+                                    '--out', str(tmp_path / 'jobs')]) == 0
+    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
+                      dashboard_address=None) as cluster:
+        assert main(worlds + methods + ['--cluster', cluster.scheduler_address,
+                                        '--out', str(tmp_path / 'cluster')]) == 0
+    jobs, on_cluster = (json.loads((tmp_path / d / 'results.json').read_text())
+                        for d in ('jobs', 'cluster'))
+    assert len(jobs['runs']) == 9
+    assert without_timing(on_cluster) == without_timing(jobs)
+    assert (tmp_path / 'cluster' / 'fig6d_big_wall.png').stat().st_size > 10_000
+
+
+def test_a_cluster_that_is_not_there_is_a_clear_error(tmp_path, capsys, worlds_dir,
+                                                      monkeypatch):
+    import subapf_planner.tools.bench as bench
+    monkeypatch.setattr(bench, 'CLUSTER_CONNECT_TIMEOUT', 2.0)
+    rc = main([str(worlds_dir / 'four_points.yaml'), '--cluster', 'tcp://127.0.0.1:9',
+               '--out', str(tmp_path / 'x'), '--no-plots'])
+    assert rc == 2 and 'cluster tcp://127.0.0.1:9' in capsys.readouterr().err

@@ -3,8 +3,9 @@ baseline on many worlds, side by side.
 
 Every (world, method) run steps the simulator and the node's decision loop in
 lockstep in one process (sim/episode.py); ``--jobs`` spreads the worlds over
-processes, each drawing its world's Fig. 6-style PNG. Writes ``results.json``,
-``summary.md`` and the PNGs to --out. One parameter file (default: the
+processes, each drawing its world's Fig. 6-style PNG, and ``--cluster`` over the
+workers of a Dask distributed cluster (the same results.json but the timings).
+Writes ``results.json``, ``summary.md`` and the PNGs to --out. One parameter file (default: the
 package's config/planner.yaml) for all worlds; a method may name its attraction
 field (``subharmonic_sampling:euclidean`` is the paper's method exactly).
 """
@@ -12,7 +13,9 @@ field (``subharmonic_sampling:euclidean`` is the paper's method exactly).
 from __future__ import annotations
 
 import argparse
-from concurrent.futures import ProcessPoolExecutor
+from collections.abc import Iterator
+from concurrent.futures import Executor, ProcessPoolExecutor
+import contextlib
 import dataclasses
 import json
 from pathlib import Path
@@ -28,7 +31,7 @@ from ..ros.paths import default_params_file, shipped_worlds_dir
 from ..sim.episode import run_episode
 from ..sim.faults import ScanFaults
 from ..sim.simulator import SimConfig
-from ..sim.world import WorldError, load_world, world_files
+from ..sim.world import World, WorldError, load_world, world_files
 from .animation import animate_run
 from .plots import plot_trajectories
 
@@ -39,6 +42,8 @@ DEFAULT_METHODS = ('subharmonic_sampling:geodesic', 'subharmonic_sampling:euclid
                    'subharmonic:euclidean', 'traditional:euclidean', 'harmonic:euclidean',
                    'dwa:euclidean', 'dwa:geodesic')
 FIELDS = ('geodesic', 'euclidean')
+#: How long --cluster waits for its scheduler [s].
+CLUSTER_CONNECT_TIMEOUT = 30.0
 
 
 def parse_method(spec: str) -> dict:
@@ -56,8 +61,7 @@ def parse_method(spec: str) -> dict:
 
 def _run_world(job: tuple) -> list[tuple[dict, list]]:
     """All methods on one world (in a worker), and its plot when ``plot_dir`` is set."""
-    path, methods, cfg, sim_cfg, faults, plot_dir, animate = job
-    world = load_world(path)
+    world, methods, cfg, sim_cfg, faults, plot_dir, animate = job
     out = []
     for spec in methods:
         run_cfg = cfg.replace(**parse_method(spec))
@@ -65,12 +69,33 @@ def _run_world(job: tuple) -> list[tuple[dict, list]]:
         result = run_episode(world, run_cfg, sim_cfg, faults=faults, label=label)
         out.append((result.metrics(world), result.path[:, :2].round(4).tolist()))
     if plot_dir is not None:
-        paths = {r['method']: np.asarray(p) for r, p in out}
-        plot_trajectories(world, paths, {r['method']: r['outcome'] for r, _ in out},
-                          Path(plot_dir) / f'{world.name}.png', cfg.period)
-        if animate:
-            animate_run(world, paths, Path(plot_dir) / f'{world.name}.gif', cfg.period)
+        _plot_world(world, out, Path(plot_dir), cfg.period, animate)
     return out
+
+
+def _plot_world(world: World, out: list[tuple[dict, list]], plot_dir: Path, period: float,
+                animate: bool) -> None:
+    """The world's PNG (and GIF) of the runs ``out`` (metrics, path) of _run_world."""
+    paths = {r['method']: np.asarray(p) for r, p in out}
+    plot_trajectories(world, paths, {r['method']: r['outcome'] for r, _ in out},
+                      plot_dir / f'{world.name}.png', period)
+    if animate:
+        animate_run(world, paths, plot_dir / f'{world.name}.gif', period)
+
+
+@contextlib.contextmanager
+def _executor(jobs: int, cluster: str | None) -> Iterator[Executor]:
+    """Where the episodes run: ``jobs`` local processes, or the workers of the Dask
+    distributed cluster whose scheduler is at ``cluster`` (its concurrent.futures
+    executor: the same map, the same results)."""
+    if cluster is None:
+        with ProcessPoolExecutor(max_workers=max(1, jobs)) as pool:
+            yield pool
+        return
+    from distributed import Client
+    with Client(cluster, timeout=CLUSTER_CONNECT_TIMEOUT) as client:
+        with client.get_executor() as pool:
+            yield pool
 
 
 def paired(runs: list[dict], methods: list[str]) -> str:
@@ -179,6 +204,10 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
     p.add_argument('--out', required=True, help='output directory')
     p.add_argument('--params', default=None, help='ROS 2 params YAML (config/planner.yaml)')
     p.add_argument('--jobs', type=int, default=1, help='worker processes')
+    p.add_argument('--cluster', default=None, metavar='ADDRESS',
+                   help='run the episodes on a Dask distributed cluster instead: its '
+                   "scheduler's address, e.g. tcp://scheduler:8786 (every worker needs "
+                   'subapf_planner installed; --jobs is not used; plots are drawn here)')
     p.add_argument('--seed', type=int, default=0, help='simulator seed (noise)')
     p.add_argument('--noise', type=float, default=0.01,
                    help='laser range noise sigma [m] (Gazebo TurtleBot3: 0.01)')
@@ -222,11 +251,21 @@ def main(argv: list[str] | None = None) -> int:
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     plot_dir = None if args.no_plots else str(out)
-    jobs = [(f, methods, cfg, sim_cfg, faults, plot_dir, args.animate) for f in worlds]
+    # on a cluster the workers' disks are not ours: the plots are drawn here
+    worker_plots = None if args.cluster else plot_dir
+    jobs = [(w, methods, cfg, sim_cfg, faults, worker_plots, args.animate)
+            for w in worlds.values()]
     t0 = time.perf_counter()
-    with ProcessPoolExecutor(max_workers=max(1, args.jobs)) as pool:
-        per_world = list(tqdm(pool.map(_run_world, jobs), total=len(jobs), unit='world',
-                              desc='subapf-bench', file=sys.stderr))
+    try:
+        with _executor(args.jobs, args.cluster) as pool:
+            per_world = list(tqdm(pool.map(_run_world, jobs), total=len(jobs), unit='world',
+                                  desc='subapf-bench', file=sys.stderr))
+    except OSError as exc:   # no scheduler at the address (distributed's timeout too)
+        print(f'subapf-bench: cluster {args.cluster}: {exc}', file=sys.stderr)
+        return 2
+    if args.cluster and plot_dir is not None:
+        for world, world_runs in zip(worlds.values(), per_world, strict=True):
+            _plot_world(world, world_runs, Path(plot_dir), cfg.period, args.animate)
     wall = time.perf_counter() - t0
     runs = [r for world_runs in per_world for r, _ in world_runs]
     labels = list(dict.fromkeys(r['method'] for r in runs))
