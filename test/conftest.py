@@ -173,14 +173,14 @@ def pytest_collection_modifyitems(config, items):
 @pytest.fixture(scope='session')
 def tf2_msgs_built() -> dict[str, str]:
     """PYTHONPATH and LD_LIBRARY_PATH for a process to import tf2_msgs: the ROS
-    install's when there is one, else test/tf2_msgs_pkg built once (test/tf_build.py)."""
+    install's (none needed) when there is one, else the package test/tf_build.py
+    builds once."""
     try:
         from tf2_msgs.msg import TFMessage  # noqa: F401
         return {}
     except ImportError:
-        from tf_build import tf2_msgs_env
-        env = tf2_msgs_env({})
-        return {k: env[k] for k in ('PYTHONPATH', 'LD_LIBRARY_PATH')}
+        from tf_build import tf2_msgs_paths
+        return tf2_msgs_paths()
 
 
 def with_paths(env: dict[str, str], paths: dict[str, str]) -> dict[str, str]:

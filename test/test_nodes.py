@@ -337,3 +337,25 @@ def test_spin_node_bad_input_only_while_building_bugs_keep_their_traceback():
     assert r.returncode not in (0, 2), r.stderr
     assert 'Traceback' in r.stderr and 'ValueError: a bug in a callback' in r.stderr
     assert 'on_shutdown ran' in r.stdout
+
+
+def test_a_static_chain_sets_the_laser_mounting_unless_a_link_of_it_is_tilted(harness):
+    """_on_tf_static, given TFMessage-shaped messages directly (this process need not
+    import tf2_msgs): a level chain base_footprint -> base_link -> base_scan replaces
+    the parameters' mounting; a tilted link in the chain keeps the parameters'."""
+    from types import SimpleNamespace
+
+    from subapf_planner.ros.conversions import transform_msg
+    h = harness(laser_x=0.5, laser_y=0.1)
+    camera = transform_msg('base_link', 'camera_optical', (0.1, 0.0, 0.2), 0.0, 0.0)
+    camera.transform.rotation.x, camera.transform.rotation.w = 0.7071, 0.7071   # tilted
+    h.node._on_tf_static(SimpleNamespace(transforms=[
+        transform_msg('base_footprint', 'base_link', (0.0, 0.0, 0.01), 0.0, 0.0),
+        transform_msg('base_link', 'base_scan', (-0.032, 0.0, 0.17), 0.2, 0.0), camera]))
+    assert h.node.ctl.cfg.laser_mount == pytest.approx((-0.032, 0.0, 0.2))
+    h = harness(laser_x=0.5, laser_y=0.1)
+    scan = transform_msg('base_link', 'base_scan', (-0.032, 0.0, 0.17), 0.0, 0.0)
+    scan.transform.rotation.x, scan.transform.rotation.w = 1.0, 0.0   # upside down
+    h.node._on_tf_static(SimpleNamespace(transforms=[
+        transform_msg('base_footprint', 'base_link', (0.0, 0.0, 0.01), 0.0, 0.0), scan]))
+    assert h.node.ctl.cfg.laser_mount == pytest.approx((0.5, 0.1, 0.0))

@@ -100,10 +100,12 @@ def test_chain_composes_the_links_from_the_base_to_the_leaf():
              'base_scan': ('base_link', (-0.032, 0.0, 0.0)),
              'turned': ('base_scan', (0.1, 0.0, math.pi / 2)),
              'tip': ('turned', (0.1, 0.0, 3.0))}
-    assert chain(links, 'base_footprint', 'base_scan') == pytest.approx((-0.032, 0.0, 0.0))
-    x, y, yaw = chain(links, 'base_footprint', 'tip')
+    pose, frames = chain(links, 'base_footprint', 'base_scan')
+    assert pose == pytest.approx((-0.032, 0.0, 0.0)) and frames == ['base_scan', 'base_link']
+    (x, y, yaw), frames = chain(links, 'base_footprint', 'tip')
     assert (x, y) == pytest.approx((0.068, 0.1)) and yaw == pytest.approx(
         math.remainder(math.pi / 2 + 3.0, 2 * math.pi))
-    assert chain(links, 'base_footprint', 'base_footprint') == (0.0, 0.0, 0.0)
+    assert frames == ['tip', 'turned', 'base_scan', 'base_link']
+    assert chain(links, 'base_footprint', 'base_footprint') == ((0.0, 0.0, 0.0), [])
     assert chain(links, 'odom', 'base_scan') is None          # not connected
     assert chain({'a': ('b', (0, 0, 0)), 'b': ('a', (0, 0, 0))}, 'c', 'a') is None   # a loop

@@ -1,10 +1,10 @@
 """tf2_msgs for the tests, where no ROS install provides it (the PyPI ROS wheels do not).
 
 Its interface is one message, ``geometry_msgs/TransformStamped[] transforms``.
-:func:`tf2_msgs_env` writes that interface package (FILES) into a cache keyed by the
+:func:`tf2_msgs_paths` writes that interface package (FILES) into a cache keyed by the
 inputs and builds it once with colcon and the ROS interface generators from PyPI, in a
-venv of their own (test/tf2_msgs_build_requirements.txt), and returns the environment
-a process needs to import it. The package lives only in the cache: a package.xml in
+venv of their own (test/tf2_msgs_build_requirements.txt), and returns the paths a
+process needs to import it. The package lives only in the cache: a package.xml in
 the source tree would be built by colcon and taken by rosdep for the real tf2_msgs.
 The generator wheels' CMake exports name their builder's Python and numpy include
 directories (/opt/python/cp311-cp311/...); they are pointed at this machine's first.
@@ -114,9 +114,10 @@ def build(root: Path) -> Path:
     return root / 'install' / 'tf2_msgs'
 
 
-def tf2_msgs_env(base: dict[str, str] | None = None) -> dict[str, str]:
-    """``base`` (default os.environ) plus what a process needs to import the built
-    tf2_msgs: PYTHONPATH and LD_LIBRARY_PATH. Builds it first if it is not cached."""
+def tf2_msgs_paths() -> dict[str, str]:
+    """What a process needs to import the built tf2_msgs, to put in front of its
+    PYTHONPATH and LD_LIBRARY_PATH (conftest.with_paths). Builds it first if it is not
+    cached."""
     root = CACHE / f'tf2_msgs-{_key()}'
     prefix = root / 'install' / 'tf2_msgs'
     if not (root / 'ok').exists():
@@ -125,8 +126,4 @@ def tf2_msgs_env(base: dict[str, str] | None = None) -> dict[str, str]:
         prefix = build(root)
         (root / 'ok').write_text('built\n')
     site = next(prefix.glob('lib/python*/site-packages'))
-    env = dict(os.environ if base is None else base)
-    env['PYTHONPATH'] = os.pathsep.join(filter(None, [str(site), env.get('PYTHONPATH')]))
-    env['LD_LIBRARY_PATH'] = os.pathsep.join(filter(None, [str(prefix / 'lib'),
-                                                           env.get('LD_LIBRARY_PATH')]))
-    return env
+    return {'PYTHONPATH': str(site), 'LD_LIBRARY_PATH': str(prefix / 'lib')}

@@ -119,8 +119,7 @@ TURTLEBOT4 = RobotDescription(
     name='turtlebot4', radius=0.175, laser=LaserMount(-0.04, 0.0, 0.193, math.pi / 2),
     wheel_radius=0.03575, wheel_separation=0.233, max_linear_velocity=0.26,
     max_angular_velocity=1.0, base_link_height=0.0, base_frame='base_link',
-    laser_frame='rplidar_link',
-    laser_range=12.0, stamped_cmd_vel=True,
+    laser_frame='rplidar_link', laser_range=12.0, stamped_cmd_vel=True,
     source='turtlebot4_navigation/config/nav2.yaml for Jazzy (robot_radius 0.175 m; '
     'velocity_smoother max_velocity 0.26 m/s, 1.0 rad/s; enable_stamped_cmd_vel true); '
     'turtlebot4_description/urdf/standard/turtlebot4.urdf.xacro (rplidar_link 0.04 m '
@@ -159,19 +158,21 @@ def to_parent(pose: ArrayLike, points: ArrayLike) -> NDArray[np.float64]:
 
 
 def chain(links: Mapping[str, tuple[str, tuple[float, float, float]]], base: str,
-          leaf: str, max_links: int = 32) -> tuple[float, float, float] | None:
+          leaf: str, max_links: int = 32
+          ) -> tuple[tuple[float, float, float], list[str]] | None:
     """The planar pose (x, y, yaw) of frame ``leaf`` in frame ``base`` from ``links``
     (child -> (parent, its pose in the parent)), walking from ``leaf`` up through its
-    parents; None when ``base`` is not among them (or the links loop). The yaw is
-    wrapped to [-pi, pi]."""
-    poses = []
+    parents, and the child frames of the links it took (leaf first); None when ``base``
+    is not among them (or the links loop). The yaw is wrapped to [-pi, pi]."""
+    poses, frames = [], []
     frame = leaf
     while frame != base:
         if frame not in links or len(poses) >= max_links:
             return None
+        frames.append(frame)
         frame, pose = links[frame]
         poses.append(pose)
     out = (0.0, 0.0, 0.0)
     for pose in reversed(poses):
         out = compose(out, pose)
-    return (out[0], out[1], math.remainder(out[2], 2.0 * math.pi))
+    return (out[0], out[1], math.remainder(out[2], 2.0 * math.pi)), frames

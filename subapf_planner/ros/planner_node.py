@@ -205,15 +205,11 @@ class PlannerNode(Node):
             self._links[child] = (parent, pose, level)
         o = self.options
         links = {c: (p, pose) for c, (p, pose, _) in self._links.items()}
-        mount = chain(links, o.base_frame, o.laser_frame) if o.laser_frame else None
-        if mount is None or mount == self._tf_mount:
+        found = chain(links, o.base_frame, o.laser_frame) if o.laser_frame else None
+        if found is None or found[0] == self._tf_mount:
             return
-        tilted, frame = [], o.laser_frame   # the links of the chain (it ends: found)
-        while frame != o.base_frame:
-            parent, _, level = self._links[frame]
-            if not level:
-                tilted.append(frame)
-            frame = parent
+        mount, frames = found
+        tilted = [f for f in frames if not self._links[f][2]]
         if tilted:
             self.get_logger().warn(f'/tf_static: {", ".join(tilted)} not level: laser '
                                    f'mounting kept from parameters {self.ctl.cfg.laser_mount}')
