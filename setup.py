@@ -12,6 +12,7 @@ PACKAGE = 'subapf_planner'
 EXECUTABLES = [
     ('ros.planner_node:main', 'planner_node', 'subapf-planner'),
     ('ros.sim_node:main', 'sim_node', 'subapf-sim'),
+    ('ros.foxglove_node:main', 'foxglove_node', 'subapf-foxglove'),
     ('tools.bringup:main', 'bringup', 'subapf-bringup'),
     ('tools.bench:main', 'bench', 'subapf-bench'),
     ('tools.figures:main', 'figures', 'subapf-figures'),
@@ -39,6 +40,7 @@ INSTALL_REQUIRES = [
     'tqdm>=4.66',
     'scikit-fmm>=2024.5',
     'distributed>=2024.1',   # subapf-bench --cluster (Dask)
+    'foxglove-sdk>=0.30,<1',   # subapf-foxglove (live view)
 ]
 
 # Which names the console scripts get. The bare names (planner_node, bench, perf, ...)

@@ -5,10 +5,13 @@ sim_node (the PyBullet burger stand-in) publishes /clock, scan, odom and the run
 outcome; planner.launch.py's planner runs on that clock with the burger's config (the
 stand-in is a burger). Send a goal on goal_pose (RViz "2D Goal Pose", frame odom);
 subapf-bringup does all this in one process tree and sends the world's goal itself.
+``foxglove:=true`` also starts foxglove_node: the run served live to Foxglove on
+ws://127.0.0.1:<foxglove_port>.
 """
 
 from launch import LaunchDescription
 from launch.actions import DeclareLaunchArgument, IncludeLaunchDescription
+from launch.conditions import IfCondition
 from launch.launch_description_sources import PythonLaunchDescriptionSource
 from launch.substitutions import LaunchConfiguration, PathJoinSubstitution
 from launch_ros.actions import Node
@@ -35,6 +38,21 @@ def generate_launch_description() -> LaunchDescription:
                 PathJoinSubstitution([share, 'config', 'planner.yaml']),
                 {'world': LaunchConfiguration('world'),
                  'rate': LaunchConfiguration('rate')},
+            ],
+        ),
+        DeclareLaunchArgument('foxglove', default_value='false', choices=['true', 'false'],
+                              description='Serve the run live to Foxglove (foxglove_node)'),
+        DeclareLaunchArgument('foxglove_port', default_value='8765',
+                              description='WebSocket port of foxglove_node'),
+        Node(
+            package=PACKAGE,
+            executable='foxglove_node',
+            name='subapf_foxglove',
+            output='screen',
+            condition=IfCondition(LaunchConfiguration('foxglove')),
+            parameters=[
+                PathJoinSubstitution([share, 'config', 'planner.yaml']),
+                {'port': LaunchConfiguration('foxglove_port')},
             ],
         ),
         IncludeLaunchDescription(

@@ -59,7 +59,7 @@ def test_grid_and_markers_of_a_corrected_memory_are_drawn_in_odom():
     result = PlanResult(Command(0.1, 0.0, Status.DRIVING), chosen_point=point,
                         obstacles=point[None], pose=np.array([1.0, 2.0, 0.0]),
                         correction=correction)
-    markers = {m.ns: m for m in markers_from_result(result, 'odom', Time(), 0.25).markers}
+    markers = {m.ns: m for m in markers_from_result(result, 'odom', Time(), 0.25, 0.105).markers}
     chosen = markers['chosen_point'].pose.position
     assert (chosen.x, chosen.y) == pytest.approx(to_parent(in_odom, point)[0])
     obs = markers['obstacles']
@@ -105,3 +105,20 @@ def test_planar_transform_gives_the_planar_part_and_whether_it_is_level():
     t.transform.rotation.x, t.transform.rotation.y, t.transform.rotation.z, \
         t.transform.rotation.w = 0.0, s, 0.0, math.cos(0.01)
     assert planar_transform(t)[3] is True
+
+
+def test_footprint_marker_outlines_the_robot_and_points_its_heading():
+    from subapf_planner.core.command import Command
+    from subapf_planner.core.planner import PlanResult
+    from subapf_planner.core.status import Status
+    from subapf_planner.ros.markers import markers_from_result
+    pose = np.array([1.0, -2.0, 0.5])
+    result = PlanResult(Command(0.0, 0.0, Status.DRIVING), obstacles=np.zeros((0, 2)),
+                        pose=pose)
+    markers = {m.ns: m for m in markers_from_result(result, 'odom', Time(), 0.25, 0.105).markers}
+    for ns, radius in (('footprint', 0.105), ('danger_circle', 0.25)):
+        xy = np.array([[p.x, p.y] for p in markers[ns].points])
+        np.testing.assert_allclose(np.hypot(*(xy[:-1] - pose[:2]).T), radius, atol=1e-12)
+        np.testing.assert_allclose(xy[0], pose[:2] + radius * np.array([np.cos(0.5),
+                                                                         np.sin(0.5)]))
+        np.testing.assert_allclose(xy[-1], pose[:2])   # the heading ends at the centre

@@ -10,6 +10,7 @@ import pytest
 from test_colcon import BARE
 
 from subapf_planner.core.robot import ROBOTS
+from subapf_planner.ros.foxglove_node import FoxgloveOptions
 from subapf_planner.ros.planner_node import GROUPS as PLANNER_GROUPS
 from subapf_planner.ros.sim_node import GROUPS as SIM_GROUPS
 
@@ -21,6 +22,7 @@ SHARE = {'config': REPO / 'config', 'worlds': REPO / 'sim' / 'worlds', 'launch':
 PARAMETERS = {
     'planner_node': {f.name for g in PLANNER_GROUPS for f in dataclasses.fields(g)},
     'sim_node': {f.name for g in SIM_GROUPS for f in dataclasses.fields(g)},
+    'foxglove_node': {f.name for f in dataclasses.fields(FoxgloveOptions)},
 }
 
 

@@ -277,7 +277,8 @@ def test_views_are_built_only_while_something_subscribes(harness, monkeypatch):
     h.peer.create_subscription(MarkerArray, '/subapf_planner/markers', got.append, 10)
     assert h.spin_until(lambda: (h.feed(), len(got) >= 3)[1])
     assert built['markers'] >= 3 and built['map'] == built['plan'] == 0
-    assert {m.ns for m in got[-1].markers} >= {'obstacles', 'samples', 'danger_circle'}
+    assert {m.ns for m in got[-1].markers} >= {'obstacles', 'samples', 'footprint',
+                                             'danger_circle'}
 
 
 def test_scans_and_odometry_are_taken_at_the_tick_not_by_the_executor(harness):

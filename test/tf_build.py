@@ -115,9 +115,10 @@ def build(root: Path) -> Path:
 
 
 def tf2_msgs_paths() -> dict[str, str]:
-    """What a process needs to import the built tf2_msgs, to put in front of its
-    PYTHONPATH and LD_LIBRARY_PATH (conftest.with_paths). Builds it first if it is not
-    cached."""
+    """What a process needs to import the built tf2_msgs and find its message
+    definition (share/tf2_msgs/msg, for MCAP and Foxglove schemas), to put in front of
+    its PYTHONPATH, LD_LIBRARY_PATH and AMENT_PREFIX_PATH (conftest.with_paths), as a
+    sourced workspace would. Builds it first if it is not cached."""
     root = CACHE / f'tf2_msgs-{_key()}'
     prefix = root / 'install' / 'tf2_msgs'
     if not (root / 'ok').exists():
@@ -126,4 +127,5 @@ def tf2_msgs_paths() -> dict[str, str]:
         prefix = build(root)
         (root / 'ok').write_text('built\n')
     site = next(prefix.glob('lib/python*/site-packages'))
-    return {'PYTHONPATH': str(site), 'LD_LIBRARY_PATH': str(prefix / 'lib')}
+    return {'PYTHONPATH': str(site), 'LD_LIBRARY_PATH': str(prefix / 'lib'),
+            'AMENT_PREFIX_PATH': str(prefix)}

@@ -42,12 +42,23 @@ def _placed(m: Marker, pose: tuple[float, float, float]) -> Marker:
     return m
 
 
+def _circle(pose: np.ndarray, radius: float, n: int = 36) -> np.ndarray:
+    """(n + 2, 2) points of a circle of ``radius`` [m] round ``pose`` (x, y, yaw),
+    starting and ending ahead of it, then its centre: the closed outline and the
+    heading as one line strip."""
+    a = pose[2] + np.linspace(0.0, 2.0 * math.pi, n + 1)
+    ring = np.column_stack((pose[0] + radius * np.cos(a), pose[1] + radius * np.sin(a)))
+    return np.vstack((ring, pose[None, :2]))
+
+
 def markers_from_result(result: PlanResult, frame: str, stamp: Time,
-                        danger_distance: float, voxel: float = 0.05) -> MarkerArray:
+                        danger_distance: float, robot_radius: float,
+                        voxel: float = 0.05) -> MarkerArray:
     """Obstacle points (voxel-downsampled, as the repulsion sees them), raw next move
-    point, samples coloured by score, chosen point, the moving tracks and the danger
-    circle around the robot, for RViz or Foxglove, in ``frame`` (odom: each marker's
-    pose carries the memory frame's place in it, ``invert(result.correction)``)."""
+    point, samples coloured by score, chosen point, the moving tracks, the robot's
+    footprint (radius [m], with its heading) and the danger circle round it, for RViz
+    or Foxglove, in ``frame`` (odom: each marker's pose carries the memory frame's
+    place in it, ``invert(result.correction)``)."""
     out = MarkerArray()
     obs = _marker('obstacles', 0, Marker.POINTS, frame, stamp, 0.03, (0.9, 0.2, 0.2, 1.0))
     obs.points = _points(voxel_downsample(result.obstacles, voxel))
@@ -74,13 +85,12 @@ def markers_from_result(result: PlanResult, frame: str, stamp: Time,
                 samples.colors.append(ColorRGBA(r=t, g=1.0 - t, b=0.2, a=1.0))
     out.markers.append(samples)
     out.markers.extend(track_markers(result, frame, stamp))
-    ring = _marker('danger_circle', 0, Marker.LINE_STRIP, frame, stamp, 0.01,
-                   (1.0, 0.0, 0.0, 0.5))
-    if result.pose is not None:
-        a = np.linspace(0.0, 2.0 * math.pi, 37)
-        ring.points = _points(np.column_stack((result.pose[0] + danger_distance * np.cos(a),
-                                               result.pose[1] + danger_distance * np.sin(a))))
-    out.markers.append(ring)
+    for ns, radius, rgba in (('footprint', robot_radius, (0.1, 0.1, 0.1, 0.9)),
+                             ('danger_circle', danger_distance, (1.0, 0.0, 0.0, 0.5))):
+        ring = _marker(ns, 0, Marker.LINE_STRIP, frame, stamp, 0.01, rgba)
+        if result.pose is not None:
+            ring.points = _points(_circle(np.asarray(result.pose, float), radius))
+        out.markers.append(ring)
     if result.correction != (0.0, 0.0, 0.0):
         memory_frame = invert(result.correction)
         out.markers = [_placed(m, memory_frame) for m in out.markers]

@@ -306,7 +306,7 @@ class PlannerNode(Node):
             self._markers_time = now
             self.marker_pub.publish(markers_from_result(
                 result, self.options.odom_frame, tick.to_msg(), cfg.danger_distance,
-                cfg.voxel_size))
+                cfg.robot_radius, cfg.voxel_size))
         if cfg.geodesic and listened(self.correction_pub):
             self.correction_pub.publish(transform_msg(
                 self.options.map_frame, self.options.odom_frame,

@@ -4,7 +4,8 @@ Starts ``sim_node`` and ``planner_node`` with localhost-only discovery and a
 ROS_DOMAIN_ID of their own, sends the world's goal on ``goal_pose``, waits for
 the simulator's outcome, stops both (also on Ctrl-C or when a child dies),
 prints the outcome, simulated time and path length, writes a trajectory PNG,
-and exits 0 only when the goal was reached.
+and exits 0 only when the goal was reached. ``--foxglove [PORT]`` also starts
+``foxglove_node``, which serves the run live to Foxglove on ws://127.0.0.1:PORT.
 """
 
 from __future__ import annotations
@@ -38,6 +39,9 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
     p.add_argument('--domain-id', type=int, default=None, help='ROS_DOMAIN_ID (default: random)')
     p.add_argument('--seed', type=int, default=0, help='simulator seed')
     p.add_argument('--noise', type=float, default=0.01, help='laser range noise [m]')
+    p.add_argument('--foxglove', type=int, nargs='?', const=8765, default=None, metavar='PORT',
+                   help='serve the run live to Foxglove on ws://127.0.0.1:PORT (default '
+                        'port 8765; foxglove_node)')
     p.add_argument('--timeout', type=float, default=None,
                    help='wall-clock limit [s] (default: 2 x time_limit / rate + 30)')
     return p.parse_args(argv)
@@ -59,10 +63,11 @@ def run_once(world: World, world_path: str, params: str, domain: int, *,
              method: str | None = None, rate: float = 1.0, seed: int = 0,
              sim_params: dict[str, float] | None = None, record: str | None = None,
              record_topics: list[str] | None = None, timeout: float | None = None,
-             log_dir: Path | None = None) -> RunResult:
-    """Start both nodes on ``domain``, send the goal, wait for the outcome, stop both.
+             log_dir: Path | None = None, foxglove_port: int | None = None) -> RunResult:
+    """Start both nodes on ``domain`` (and foxglove_node serving on ``foxglove_port``),
+    send the goal, wait for the outcome, stop them.
 
-    The nodes' output goes to the terminal, or to ``log_dir``/{sim,planner}.log.
+    The nodes' output goes to the terminal, or to ``log_dir``/{sim,planner,foxglove}.log.
     """
     env = join_domain(domain)
     planner_args = ['--params-file', params, '-p', 'use_sim_time:=true']
@@ -76,12 +81,14 @@ def run_once(world: World, world_path: str, params: str, domain: int, *,
     from ..ros.supervisor import Supervisor  # rclpy only after the environment is set
     children: list[subprocess.Popen] = []
     sup = None
-    logs = {name: (log_dir / f'{name}.log' if log_dir else None) for name in ('sim', 'planner')}
+    nodes = {'sim_node': sim_args, 'planner_node': planner_args}
+    if foxglove_port is not None:
+        nodes['foxglove_node'] = ['-p', f'port:={foxglove_port}']
     try:
-        children = [start('sim_node', sim_args, env, log=logs['sim']),
-                    start('planner_node', planner_args, env, log=logs['planner'])]
+        children = [start(node, node_args, env, log=log_dir / f'{node.split("_")[0]}.log'
+                          if log_dir else None) for node, node_args in nodes.items()]
         sup = Supervisor(world, record, method or load_config(params).method, record_topics)
-        outcome = sup.run(children, timeout, names=('sim_node', 'planner_node'))
+        outcome = sup.run(children, timeout, names=tuple(nodes))
     except KeyboardInterrupt:   # before the supervisor took over the signals
         outcome = 'interrupted'
     finally:
@@ -108,6 +115,9 @@ def main(argv: list[str] | None = None) -> int:
     if not 0.1 <= args.rate <= 100.0:
         print('subapf-bringup: --rate must be in [0.1, 100]', file=sys.stderr)
         return 2
+    if args.foxglove is not None and not 0 <= args.foxglove <= 65535:
+        print('subapf-bringup: --foxglove PORT must be in [0, 65535]', file=sys.stderr)
+        return 2
     if args.domain_id is not None and not 0 <= args.domain_id <= 101:
         print('subapf-bringup: --domain-id must be in [0, 101]', file=sys.stderr)
         return 2
@@ -124,7 +134,8 @@ def main(argv: list[str] | None = None) -> int:
     result = run_once(world, str(Path(args.world).resolve()), params, domain,
                       method=args.method, rate=args.rate, seed=args.seed,
                       sim_params={'range_noise': args.noise}, record=args.record,
-                      record_topics=args.record_topics, timeout=args.timeout)
+                      record_topics=args.record_topics, timeout=args.timeout,
+                      foxglove_port=args.foxglove)
     print(f'subapf-bringup: outcome {result.outcome}, simulated time {result.sim_time:.1f} s, '
           f'path length {path_length(result.path):.2f} m', flush=True)
     if len(result.path):

@@ -63,6 +63,7 @@ def _section(node: str, groups: list[tuple[str, type]]) -> list[str]:
 
 def render() -> str:
     """The whole params file."""
+    from ..ros.foxglove_node import FoxgloveOptions
     from ..ros.planner_node import NodeOptions
     from ..ros.sim_node import SimNodeOptions
     planner = _section('subapf_planner', [('node (ros/planner_node.py)', NodeOptions),
@@ -71,7 +72,8 @@ def render() -> str:
     sim = _section('subapf_sim', [('node (ros/sim_node.py)', SimNodeOptions),
                                   ('simulator (sim/simulator.py)', SimConfig),
                                   ('scan faults (sim/faults.py)', ScanFaults)])
-    return HEADER + '\n'.join(planner + [''] + sim) + '\n'
+    relay = _section('subapf_foxglove', [('node (ros/foxglove_node.py)', FoxgloveOptions)])
+    return HEADER + '\n'.join(planner + [''] + sim + [''] + relay) + '\n'
 
 
 def robot_parameters(robot: RobotDescription) -> dict[str, float | str | bool]:

@@ -15,47 +15,18 @@ import time
 import rclpy
 from rclpy.executors import ExternalShutdownException
 from rclpy.node import Node
-from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from rclpy.signals import SignalHandlerOptions
 
-from ..bag.reader import BagError, message_class
+from ..bag.reader import BagError
 from ..bag.writer import McapRecorder, RecorderError
 from ..ros.spinning import stop_on_signals
-
-DEPTH = 500
+from ..ros.tap import TopicTap
 
 
 class RecordNode(Node):
     def __init__(self, wanted: list[str], recorder: McapRecorder) -> None:
         super().__init__('subapf_record')
-        self.wanted = [t if t.startswith('/') else '/' + t for t in wanted]
-        self.recorder = recorder
-        self.subscribed: set[str] = set()
-        self.create_timer(0.2, self._discover)
-
-    def _discover(self) -> None:
-        for topic, types in self.get_topic_names_and_types():
-            if topic not in self.wanted or topic in self.subscribed or not types:
-                continue
-            offered = self.get_publishers_info_by_topic(topic)
-            if not offered:
-                continue   # known from a subscriber only: wait to see the publishers' QoS
-            best_effort = any(i.qos_profile.reliability == ReliabilityPolicy.BEST_EFFORT
-                              for i in offered)
-            latched = all(i.qos_profile.durability
-                                      == DurabilityPolicy.TRANSIENT_LOCAL for i in offered)
-            qos = QoSProfile(depth=DEPTH, reliability=ReliabilityPolicy.BEST_EFFORT
-                             if best_effort else ReliabilityPolicy.RELIABLE,
-                             durability=DurabilityPolicy.TRANSIENT_LOCAL if latched
-                             else DurabilityPolicy.VOLATILE)
-            self.recorder.add_topic(topic, types[0])
-            self.create_subscription(message_class(types[0]), topic, self._writer(topic), qos,
-                                     raw=True)
-            self.subscribed.add(topic)
-            self.get_logger().info(f'recording {topic} ({types[0]})')
-
-    def _writer(self, topic: str):
-        return lambda data: self.recorder.write(topic, data, time.time_ns())
+        self.tap = TopicTap(self, wanted, recorder, 'recording')
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -1,0 +1,107 @@
+"""``foxglove_node`` (``subapf-foxglove``): a run served live to Foxglove.
+
+A WebSocket server (the foxglove-sdk package, protocol ``foxglove.sdk.v1``) that
+relays the planner's and the simulator's topics as they are: raw CDR with their
+``ros2msg`` schemas (the message definitions a rosbag2 MCAP holds), one channel
+per topic, advertised once the topic has a publisher. Foxglove decodes them as
+it decodes a ROS 2 bag: open ``ws://HOST:PORT`` (Open connection, Foxglove
+WebSocket). By default it serves the scan, odometry, ground truth, /tf and
+/tf_static, the goal, cmd_vel, the moving obstacles, the outcome and the
+planner's memory map, plan, markers (obstacle points, samples and their scores,
+chosen point, footprint, danger circle, tracks), status and drift correction.
+Nothing is deserialised: the relay costs a copy per message, in its own process.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+import sys
+
+from rclpy.node import Node
+
+from ..bag.writer import RecorderError, message_definition
+from ..core.params import ConfigError, check_fields, param
+from .parameters import declare, read
+from .spinning import spin_node
+from .tap import TopicTap
+
+#: Topics served by default (relative ones in the relay's namespace): what
+#: config/subapf.rviz shows, and the rest of a run.
+SERVED = ('scan', 'odom', 'ground_truth', '/tf', '/tf_static', 'goal_pose', 'cmd_vel',
+          'moving_obstacles', 'sim_outcome', 'subapf_planner/markers', 'subapf_planner/map',
+          'subapf_planner/plan', 'subapf_planner/status', 'subapf_planner/correction')
+#: The WebSocket subprotocol the SDK's server speaks.
+SUBPROTOCOL = 'foxglove.sdk.v1'
+
+
+@dataclass(frozen=True)
+class FoxgloveOptions:
+    """The relay's parameters."""
+
+    port: int = param(8765, 'WebSocket port (0: any free port, logged at start)', '', 0,
+                      65535, read_only=True)
+    host: str = param('127.0.0.1', 'Address to listen on (0.0.0.0: every interface)',
+                      read_only=True)
+    topics: str = param(' '.join(SERVED), 'Topics to serve, separated by spaces (relative '
+                        "names in the node's namespace)", read_only=True)
+
+    def __post_init__(self) -> None:
+        check_fields(self)
+        if not self.topics.split():
+            raise ConfigError('topics: no topic to serve')
+
+
+class FoxgloveNode(Node):
+    """Serves ``topics`` over the Foxglove WebSocket protocol (see the module)."""
+
+    def __init__(self, **kwargs) -> None:
+        super().__init__('subapf_foxglove', **kwargs)
+        declare(self, FoxgloveOptions)
+        options = read(self, FoxgloveOptions)
+        try:
+            import foxglove
+        except ImportError as exc:
+            raise ConfigError('the foxglove-sdk package is not installed '
+                              '(pip install foxglove-sdk)') from exc
+        self._foxglove = foxglove
+        self.fg_context = foxglove.Context()
+        try:
+            self.server = foxglove.start_server(name='subapf_planner', host=options.host,
+                                                port=options.port, context=self.fg_context)
+        except RuntimeError as exc:   # the address is taken or cannot be bound
+            raise ConfigError(f'port: cannot serve on {options.host}:{options.port}: '
+                              f'{exc}') from exc
+        self.channels: dict[str, object] = {}
+        self.tap = TopicTap(self, options.topics.split(), self, 'serving')
+        self.get_logger().info(f'Foxglove WebSocket on ws://{options.host}:{self.server.port}')
+
+    def add_topic(self, topic: str, type_name: str) -> bool:
+        """A channel for the topic: CDR messages, the type's ros2msg definition as schema
+        (False, with an error logged, when the definition cannot be found)."""
+        try:
+            definition = message_definition(type_name)
+        except RecorderError as exc:
+            self.get_logger().error(f'not serving {topic}: {exc}')
+            return False
+        fg = self._foxglove
+        schema = fg.Schema(name=type_name, encoding='ros2msg', data=definition.encode())
+        self.channels[topic] = fg.Channel(topic, schema=schema, message_encoding='cdr',
+                                          context=self.fg_context)
+        return True
+
+    def write(self, topic: str, data: bytes, log_time: int) -> None:
+        channel = self.channels.get(topic)
+        if channel is not None:
+            channel.log(data, log_time=log_time)
+
+    def destroy_node(self) -> None:
+        self.server.stop()
+        super().destroy_node()
+
+
+def main(args: list[str] | None = None) -> int:
+    return spin_node(lambda: FoxgloveNode(), 'subapf-foxglove', (ConfigError,), args=args)
+
+
+if __name__ == '__main__':
+    sys.exit(main())
