@@ -55,6 +55,29 @@ def test_a_standing_object_and_a_wall_do_not_move():
     assert np.hypot(*tracks.velocity[0]) < 0.04
 
 
+def first_moving_time(log_odds: float, speed: float = 0.22) -> float:
+    """When a disc of radius 0.25 m walking at ``speed`` [m/s] across cells of the
+    memory's ``log_odds`` is first known to move [s after it was first seen]."""
+    tr = Tracker(0.15, 1.2, 0.6, 0.04)
+    for k in range(30):
+        t = 0.2 * k
+        pts = disc_points((2.0 + speed * t, 1.0), 0.25)
+        if tr.update(pts, t, np.full(len(pts), log_odds)).moving.any():
+            return t
+    return math.inf
+
+
+def test_a_walker_where_the_memory_saw_free_space_is_known_to_move_sooner():
+    """Something new on cells seen free moves once it went NEW_MOVE_DISTANCE, anything
+    else MOVE_DISTANCE: a walker at the burger's top speed, 0.22 m/s, is known to move
+    in under 1 s (0.15 m and the filter's lag) on free cells, not before it went 0.3 m
+    elsewhere."""
+    from subapf_planner.core.tracking import MOVE_DISTANCE, NEW_MOVE_DISTANCE
+    on_free, on_unknown = first_moving_time(-1.0), first_moving_time(0.0)
+    assert NEW_MOVE_DISTANCE / 0.22 <= on_free < 1.0
+    assert on_unknown >= MOVE_DISTANCE / 0.22 > on_free
+
+
 def scan_of(robot, discs=(), walls=()):
     """Ranges of a 360-beam laser at ``robot`` (laser at the origin of base_footprint is
     not the burger's: the test planner uses laser_x = 0) seeing discs and straight walls
@@ -107,12 +130,13 @@ def head_on(speed=0.2, at=0.7):
 
 def test_something_coming_at_a_standing_robot_makes_it_back_off():
     """Standing still (the plan) with a walker coming at it, and room behind: the robot
-    backs away; with a wall right behind it, it turns aside instead of reversing into
-    the wall; with reversing off it never backs."""
+    backs away (at its top speed); with a wall right behind it, it turns aside instead
+    of reversing into the wall; with reversing off it never backs."""
     pose = np.array([0.0, 0.0, 0.0])
     v, w = evade(pose, (0.0, 0.0), head_on(), np.zeros((0, 2)), CFG,
                  blocked_ahead=False).command
-    assert v < 0.0
+    # at the robot's top speed, by default: slower, a walker at that speed catches it
+    assert v == -CFG.reverse_speed == -CFG.max_linear_velocity
     wall_behind = np.column_stack((np.full(20, -0.2), np.linspace(-1, 1, 20)))
     v, w = evade(pose, (0.0, 0.0), head_on(), wall_behind, CFG, blocked_ahead=False).command
     assert v >= 0.0 and w != 0.0

@@ -154,13 +154,17 @@ class PlannerConfig:
     track_gate: float = param(0.6, "A cluster farther than this from a track's prediction "
                               'is not that track', 'm', 0.05, 5.0)
     moving_speed: float = param(0.04, 'A track at least this fast moves', 'm/s', 0.0, 5.0)
-    prediction_horizon: float = param(2.0, 'How far ahead moving tracks are predicted and '
-                                      'the command rolled out against them', 's', 0.2, 10.0)
+    prediction_horizon: float = param(3.0, 'How far ahead moving tracks are predicted and '
+                                      'the command rolled out against them (at 2 s, an escape '
+                                      'that ran ahead of a walker into clutter or another '
+                                      "walker's lane was seen too late)", 's', 0.2, 10.0)
     moving_clearance: float = param(0.1, 'Gap kept between the footprint and a moving '
                                     "track's predicted disc", 'm', 0.0, 2.0)
-    reverse_speed: float = param(0.15, 'Speed at which the robot may back away from '
-                                 'something coming at it (0: never reverses; the burger '
-                                 'backs at up to 0.22 m/s)', 'm/s', 0.0, 5.0)
+    reverse_speed: float = param(BURGER.max_linear_velocity, 'Speed at which the robot may '
+                                 'back away from something coming at it (0: never '
+                                 'reverses; the robot backs at up to its top speed: '
+                                 'slower, a walker at that speed catches it)', 'm/s', 0.0,
+                                 5.0)
     # --- DWA baseline (Fox, Burgard, Thrun 1997) ---------------------------------------
     dwa_clearance: float = param(BURGER.clearance, 'DWA: arcs passing closer than this to an '
                                  'obstacle point are inadmissible (robot_radius + 0.03 m)',
@@ -237,6 +241,7 @@ def robot_fields(robot: RobotDescription) -> dict[str, float]:
         'laser_x': mount.x, 'laser_y': mount.y, 'laser_yaw': round(mount.yaw, 6),
         'obstacle_range': min(robot.laser_range, PlannerConfig.map_size / 2),
         'max_linear_velocity': robot.max_linear_velocity,
+        'reverse_speed': robot.max_linear_velocity,
         'max_angular_velocity': robot.max_angular_velocity}
 
 

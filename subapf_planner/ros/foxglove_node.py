@@ -19,6 +19,11 @@ import sys
 
 from rclpy.node import Node
 
+try:
+    import foxglove
+except ImportError:   # a Jazzy workspace without the pip line: a clear error at start
+    foxglove = None
+
 from ..bag.writer import RecorderError, message_definition
 from ..core.params import ConfigError, check_fields, param
 from .parameters import declare, read
@@ -58,12 +63,9 @@ class FoxgloveNode(Node):
         super().__init__('subapf_foxglove', **kwargs)
         declare(self, FoxgloveOptions)
         options = read(self, FoxgloveOptions)
-        try:
-            import foxglove
-        except ImportError as exc:
+        if foxglove is None:
             raise ConfigError('the foxglove-sdk package is not installed '
-                              '(pip install foxglove-sdk)') from exc
-        self._foxglove = foxglove
+                              '(pip install foxglove-sdk)')
         self.fg_context = foxglove.Context()
         try:
             self.server = foxglove.start_server(name='subapf_planner', host=options.host,
@@ -83,10 +85,9 @@ class FoxgloveNode(Node):
         except RecorderError as exc:
             self.get_logger().error(f'not serving {topic}: {exc}')
             return False
-        fg = self._foxglove
-        schema = fg.Schema(name=type_name, encoding='ros2msg', data=definition.encode())
-        self.channels[topic] = fg.Channel(topic, schema=schema, message_encoding='cdr',
-                                          context=self.fg_context)
+        schema = foxglove.Schema(name=type_name, encoding='ros2msg', data=definition.encode())
+        self.channels[topic] = foxglove.Channel(topic, schema=schema, message_encoding='cdr',
+                                                context=self.fg_context)
         return True
 
     def write(self, topic: str, data: bytes, log_time: int) -> None:
@@ -100,7 +101,7 @@ class FoxgloveNode(Node):
 
 
 def main(args: list[str] | None = None) -> int:
-    return spin_node(lambda: FoxgloveNode(), 'subapf-foxglove', (ConfigError,), args=args)
+    return spin_node(FoxgloveNode, 'subapf-foxglove', (ConfigError,), args=args)
 
 
 if __name__ == '__main__':
