@@ -212,3 +212,40 @@ def test_package_fastdds_profile_is_used_unless_the_user_chose_one(monkeypatch):
     monkeypatch.setenv(PROFILE_VARS[1], '/elsewhere/mine.xml')
     assert use_package_profile() == '/elsewhere/mine.xml'
     assert PROFILE_VARS[0] not in os.environ
+
+
+def gone(pid: int) -> bool:
+    """The process has exited (no such process, or a zombie nobody reaped yet)."""
+    try:
+        status = Path(f'/proc/{pid}/status').read_text()
+    except OSError:
+        return True
+    return any(line.startswith('State:') and 'Z' in line.split()[1]
+               for line in status.splitlines())
+
+
+def test_a_node_stops_when_the_process_that_started_it_is_killed(ros_env):
+    """SIGKILL to what started sim_node (a bringup, say) leaves no node on the domain:
+    the child gets SIGTERM (processes.start: PR_SET_PDEATHSIG)."""
+    import subprocess
+    import sys
+    code = ('import os, time\n'
+            'from subapf_planner.ros.processes import start\n'
+            f"p = start('sim_node', ['-p', 'world:={WORLD}'], dict(os.environ), quiet=True)\n"
+            'print(p.pid, flush=True)\n'
+            'time.sleep(120)\n')
+    parent = subprocess.Popen([sys.executable, '-c', code], env=ros_env,
+                              stdout=subprocess.PIPE, text=True)
+    try:
+        child = int(parent.stdout.readline())
+        time.sleep(3.0)
+        assert not gone(child)
+        parent.kill()
+        parent.wait(timeout=10)
+        deadline = time.monotonic() + 20.0
+        while not gone(child) and time.monotonic() < deadline:
+            time.sleep(0.2)
+        assert gone(child)
+    finally:
+        parent.kill()
+        parent.wait()

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import ctypes
 import os
 from pathlib import Path
 import signal
@@ -44,9 +45,25 @@ def join_domain(domain_id: int) -> dict[str, str]:
     return dict(os.environ, PYTHONUNBUFFERED='1')
 
 
+#: Linux prctl(2) option: the signal a process gets when the thread that started it ends.
+PR_SET_PDEATHSIG = 1
+
+
+def _stop_with_parent() -> None:
+    """In a child, before exec: SIGTERM when its parent dies, SIGKILL included (Linux's
+    PR_SET_PDEATHSIG; elsewhere nothing), so that no node outlives a killed bringup on
+    its domain; SIGTERM stops a node cleanly (zero velocity first)."""
+    try:
+        ctypes.CDLL(None, use_errno=True).prctl(PR_SET_PDEATHSIG, int(signal.SIGTERM))
+    except (OSError, AttributeError):
+        pass
+
+
 def start(module: str, ros_args: list[str], env: dict[str, str], quiet: bool = False,
           log: Path | None = None) -> subprocess.Popen:
-    """A node as a child process in its own process group (so it can be stopped whole).
+    """A node as a child process in its own process group (so it can be stopped whole),
+    stopped by SIGTERM if this process dies first (call it from the thread that lives
+    as long as the node should: the signal comes when that thread ends).
 
     ``quiet`` discards its output (its exit code still tells failure); ``log`` sends
     stdout and stderr to that file instead.
@@ -60,7 +77,7 @@ def start(module: str, ros_args: list[str], env: dict[str, str], quiet: bool = F
     try:
         return subprocess.Popen([sys.executable, '-m', f'subapf_planner.ros.{module}',
                                  '--ros-args', *ros_args], env=env, start_new_session=True,
-                                **pipes)
+                                preexec_fn=_stop_with_parent, **pipes)
     finally:
         if out is not None:
             out.close()
