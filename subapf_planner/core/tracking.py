@@ -19,7 +19,8 @@ Python object per track per step for the same equations.
 
 A track **moves** when it has been seen MIN_HITS times, its estimated speed is
 at least ``moving_speed``, and it has been MOVE_DISTANCE from where it was
-first seen at some time (someone walking to and fro stays a mover). It is
+first seen at some time (NEW_MOVE_DISTANCE if it was new then: standing on cells
+the memory had seen free; someone walking to and fro stays a mover). It is
 **held** out of the occupancy memory while it moves, and while its cluster is new
 and stands mostly on cells the memory has seen free (something new where there
 was nothing: held NEW_OBJECT_SCANS scans, then written if it did not move).
@@ -52,8 +53,8 @@ NEW_OBJECT_SCANS = 15
 MOVE_DISTANCE = 0.3
 #: ... or this far, if it was new when first seen (standing on cells the memory had
 #: seen free: something came where there was nothing). At MOVE_DISTANCE alone, a walker
-#: at the robot's top speed was known to move only 1.1 s after it was first seen, too
-#: late to get out of its way (arena_003, clutter_walkers_011 of the moving suite:
+#: at the robot's top speed was known to move 1.4 s after it was first seen (0.8 s with
+#: this), too late to get out of its way (arena_003, clutter_walkers_011 of the moving suite:
 #: README, "Moving-obstacle suite"); at this distance for every track, a static
 #: cluster in a BARN world moved and its gap closed (barn_014).
 NEW_MOVE_DISTANCE = 0.15

@@ -49,9 +49,9 @@ def offered_qos(offered: list, depth: int = DEPTH) -> QoSProfile:
 
 class TopicTap:
     """Subscribes ``node`` to each of ``wanted`` (relative names resolved in the node's
-    namespace, with its remappings) once published,
-    and hands every message to ``sink``. ``subscribed`` maps each topic to its type; each
-    new one is logged as "<verb> <topic> (<type>)"."""
+    namespace, with its remappings) once published, and hands every message to
+    ``sink``. ``subscribed`` maps each topic to its type; each new one is logged as
+    "<verb> <topic> (<type>)"."""
 
     def __init__(self, node: Node, wanted: list[str], sink: Sink, verb: str = 'taking') -> None:
         self.node, self.sink, self.verb = node, sink, verb
