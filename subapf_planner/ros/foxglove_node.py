@@ -67,9 +67,14 @@ class FoxgloveNode(Node):
             raise ConfigError('the foxglove-sdk package is not installed '
                               '(pip install foxglove-sdk)')
         self.fg_context = foxglove.Context()
+        #: The last message of each latched (transient local) topic, sent again to each
+        #: client that subscribes, as a late DDS subscriber would get it: a Foxglove
+        #: opened after the start still gets /tf_static and the map.
+        self.latched: dict[str, tuple[bytes, int]] = {}
         try:
             self.server = foxglove.start_server(name='subapf_planner', host=options.host,
-                                                port=options.port, context=self.fg_context)
+                                                port=options.port, context=self.fg_context,
+                                                server_listener=self)
         except RuntimeError as exc:   # the address is taken or cannot be bound
             raise ConfigError(f'port: cannot serve on {options.host}:{options.port}: '
                               f'{exc}') from exc
@@ -92,8 +97,19 @@ class FoxgloveNode(Node):
 
     def write(self, topic: str, data: bytes, log_time: int) -> None:
         channel = self.channels.get(topic)
-        if channel is not None:
-            channel.log(data, log_time=log_time)
+        if channel is None:
+            return
+        if self.tap.latched.get(topic):
+            self.latched[topic] = (data, log_time)
+        channel.log(data, log_time=log_time)
+
+    def on_subscribe(self, client, channel) -> None:
+        """A client subscribed (the SDK's server thread): a latched topic's last message
+        again (every subscriber of the channel gets it; for a latched topic a repeat
+        is harmless)."""
+        last = self.latched.get(channel.topic)
+        if last is not None:
+            self.channels[channel.topic].log(last[0], log_time=last[1])
 
     def destroy_node(self) -> None:
         self.server.stop()

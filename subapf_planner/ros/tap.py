@@ -57,6 +57,8 @@ class TopicTap:
         self.node, self.sink, self.verb = node, sink, verb
         self.wanted = {node.resolve_topic_name(t) for t in wanted}
         self.subscribed: dict[str, str] = {}
+        #: Per subscribed topic: whether its publishers all latch (transient local).
+        self.latched: dict[str, bool] = {}
         self.refused: set[str] = set()
         node.create_timer(DISCOVERY_PERIOD, self.discover)
 
@@ -72,8 +74,10 @@ class TopicTap:
             if self.sink.add_topic(topic, types[0]) is False:
                 self.refused.add(topic)
                 continue
+            qos = offered_qos(offered)
+            self.latched[topic] = qos.durability == DurabilityPolicy.TRANSIENT_LOCAL
             self.node.create_subscription(message_class(types[0]), topic, self._handing(topic),
-                                          offered_qos(offered), raw=True)
+                                          qos, raw=True)
             self.subscribed[topic] = types[0]
             self.node.get_logger().info(f'{self.verb} {topic} ({types[0]})')
 
