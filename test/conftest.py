@@ -172,9 +172,9 @@ def pytest_collection_modifyitems(config, items):
 
 @pytest.fixture(scope='session')
 def tf2_msgs_built() -> dict[str, str]:
-    """PYTHONPATH and LD_LIBRARY_PATH for a process to import tf2_msgs: the ROS
-    install's (none needed) when there is one, else the package test/tf_build.py
-    builds once."""
+    """PYTHONPATH, LD_LIBRARY_PATH and AMENT_PREFIX_PATH for a process to import
+    tf2_msgs and find its .msg: the ROS install's (none needed) when there is one, else
+    the package test/tf_build.py builds once."""
     try:
         from tf2_msgs.msg import TFMessage  # noqa: F401
         return {}

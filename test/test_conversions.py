@@ -105,6 +105,9 @@ def test_planar_transform_gives_the_planar_part_and_whether_it_is_level():
     t.transform.rotation.x, t.transform.rotation.y, t.transform.rotation.z, \
         t.transform.rotation.w = 0.0, s, 0.0, math.cos(0.01)
     assert planar_transform(t)[3] is True
+    t.transform.rotation.x, t.transform.rotation.y = 0.0, 0.0   # zero: no rotation at all
+    t.transform.rotation.z, t.transform.rotation.w = 0.0, 0.0
+    assert planar_transform(t)[3] is False
 
 
 def test_footprint_marker_outlines_the_robot_and_points_its_heading():

@@ -58,13 +58,23 @@ def scan_to_msg(scan: Scan, frame_id: str, scan_time: float = 0.2) -> LaserScan:
     return msg
 
 
-def yaw_from_quaternion(x: float, y: float, z: float, w: float) -> float:
-    """Yaw of a quaternion (normalised first); NaN for a zero or non-finite one."""
+def _unit_quaternion(x: float, y: float, z: float, w: float
+                     ) -> tuple[float, float, float, float] | None:
+    """The quaternion normalised; None for a zero or non-finite one."""
     n = math.sqrt(x * x + y * y + z * z + w * w)
     if not math.isfinite(n) or n < 1e-9:
-        return math.nan
-    x, y, z, w = x / n, y / n, z / n, w / n
+        return None
+    return x / n, y / n, z / n, w / n
+
+
+def _yaw_of_unit(x: float, y: float, z: float, w: float) -> float:
     return math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
+
+
+def yaw_from_quaternion(x: float, y: float, z: float, w: float) -> float:
+    """Yaw of a quaternion (normalised first); NaN for a zero or non-finite one."""
+    q = _unit_quaternion(x, y, z, w)
+    return math.nan if q is None else _yaw_of_unit(*q)
 
 
 def pose_from_odom(msg: Odometry) -> np.ndarray:
@@ -111,14 +121,18 @@ LEVEL_TOLERANCE = 0.05
 def planar_transform(t: TransformStamped) -> tuple[str, str, tuple[float, float, float],
                                                    bool]:
     """(parent, child, (x, y, yaw), level) of a transform: its planar part, and whether
-    its roll and pitch are within LEVEL_TOLERANCE."""
-    q = t.transform.rotation
-    x, y, z, w = q.x, q.y, q.z, q.w
-    roll = math.atan2(2.0 * (w * x + y * z), 1.0 - 2.0 * (x * x + y * y))
-    pitch = math.asin(max(-1.0, min(1.0, 2.0 * (w * y - z * x))))
-    yaw = math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
+    its roll and pitch are within LEVEL_TOLERANCE (the rotation normalised first; a
+    zero or non-finite one is not level, its yaw NaN)."""
+    r = t.transform.rotation
     v = t.transform.translation
-    level = abs(roll) <= LEVEL_TOLERANCE and abs(pitch) <= LEVEL_TOLERANCE
+    q = _unit_quaternion(r.x, r.y, r.z, r.w)
+    yaw, level = math.nan, False
+    if q is not None:
+        x, y, z, w = q
+        yaw = _yaw_of_unit(x, y, z, w)
+        roll = math.atan2(2.0 * (w * x + y * z), 1.0 - 2.0 * (x * x + y * y))
+        pitch = math.asin(max(-1.0, min(1.0, 2.0 * (w * y - z * x))))
+        level = abs(roll) <= LEVEL_TOLERANCE and abs(pitch) <= LEVEL_TOLERANCE
     return t.header.frame_id, t.child_frame_id, (float(v.x), float(v.y), yaw), level
 
 
