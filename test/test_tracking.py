@@ -8,7 +8,15 @@ import numpy as np
 import pytest
 
 from subapf_planner.core.config import PlannerConfig
-from subapf_planner.core.evasion import Escape, evade, rollout, rollouts
+from subapf_planner.core.evasion import (
+    STATIC_MARGIN,
+    Escape,
+    evade,
+    halted,
+    moving_gap,
+    rollout,
+    rollouts,
+)
 from subapf_planner.core.planner import Planner
 from subapf_planner.core.scan import Scan
 from subapf_planner.core.tracking import Tracker, Tracks
@@ -206,3 +214,42 @@ def test_escape_command_is_its_first_step():
     assert Escape(0.1, (0.5, 0.0)).command == (0.1, 0.5)
     assert Escape(0.1, (0.5, 0.0)).advanced() == Escape(0.1, (0.0, 0.0))
 
+
+
+def test_a_rollout_halts_before_a_static_point():
+    """Straight at 0.2 m/s towards a wall at x = 0.5: the rollout stands from the first
+    step within robot_radius + STATIC_MARGIN of it at the point before; a path that
+    never comes that close, and any path without static points, is unchanged."""
+    pose = np.zeros(3)
+    paths = rollouts(pose, np.array([0.2, -0.2]), np.zeros((2, 15)))
+    wall = np.column_stack((np.full(41, 0.5), np.linspace(-1.0, 1.0, 41)))
+    out, first = halted(pose, paths, wall, CFG.robot_radius)
+    limit = 0.5 - CFG.robot_radius - STATIC_MARGIN
+    k = int(np.argmax(paths[0, :, 0] > limit))
+    assert first.tolist() == [k, 15]
+    np.testing.assert_array_equal(out[0, :k], paths[0, :k])
+    np.testing.assert_array_equal(out[0, k:], np.repeat(paths[0, k - 1][None], 15 - k, 0))
+    np.testing.assert_array_equal(out[1], paths[1])           # backing away: unchanged
+    out, first = halted(pose, paths, np.zeros((0, 2)), CFG.robot_radius)
+    assert first.tolist() == [15, 15] and out is paths
+
+
+def test_chased_towards_a_wall_it_steps_aside_instead_of_running_ahead():
+    """A walker coming up from behind at the robot's top speed, a wall 0.5 m ahead:
+    running ahead keeps the gap only until the wall stops the robot, so the escape
+    turns aside and its rollout keeps the clearance to the walker's prediction
+    (counting the robot as standing where a wall stops it). With rollouts that ran
+    through walls, running straight ahead would have been chosen."""
+    pose = np.zeros(3)
+    chaser = Tracks(np.array([[-0.55, 0.0]]), np.array([[CFG.max_linear_velocity, 0.0]]),
+                    np.array([0.25]), np.array([True]), np.array([True]),
+                    np.zeros(0, np.int64))
+    wall = np.column_stack((np.full(81, 0.5), np.linspace(-2.0, 2.0, 81)))
+    esc = evade(pose, (0.0, 0.0), chaser, wall, CFG, False)
+    assert esc is not None and esc.turn[0] != 0.0
+    path, _ = halted(pose, rollouts(pose, np.array([esc.v]), np.array([esc.turn])), wall,
+                     CFG.robot_radius)
+    assert moving_gap(path[0], chaser, CFG.robot_radius) >= CFG.moving_clearance
+    ahead, _ = halted(pose, rollouts(pose, np.array([CFG.max_linear_velocity]),
+                                     np.zeros((1, len(esc.turn)))), wall, CFG.robot_radius)
+    assert moving_gap(ahead[0], chaser, CFG.robot_radius) < CFG.moving_clearance

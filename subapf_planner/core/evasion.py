@@ -9,10 +9,12 @@ disc must stay above ``moving_clearance``. When it does not, a small set of
 escape manoeuvres is rolled out the same way (all at once, as arrays): forward,
 slower, standing still and backing up at ``reverse_speed`` (the burger backs at
 up to 0.22 m/s), each straight or turning, for the whole horizon or for a while
-and then straight (stepping aside to pass). A candidate is admissible only if
-its first EVASION_COMMIT seconds keep ``robot_radius + STATIC_MARGIN`` from
-every laser point that is not a moving track's, and the safety corridor does
-not block its forward speed. Among the admissible ones that keep the clearance,
+and then straight (stepping aside to pass). An escape's rollout halts where it
+would come within ``robot_radius + STATIC_MARGIN`` of a laser point that is not a
+moving track's (a robot that runs ahead of a walker into a wall stands there when
+the walker arrives), and it is admissible only if it does not halt within its
+first EVASION_COMMIT seconds and the safety corridor does not block its forward
+speed. Among the admissible ones that keep the clearance,
 the one closest to the planned command wins (the robot steps aside rather than
 turns back); when none keeps it, one that never touches a predicted disc within
 the horizon, else the one that touches latest, and among those the largest gap
@@ -28,6 +30,7 @@ import math
 
 import numpy as np
 from numpy.typing import NDArray
+from scipy.spatial import cKDTree
 
 from .config import PlannerConfig
 from .tracking import Tracks
@@ -135,14 +138,25 @@ def contact_time(gaps: NDArray[np.float64]) -> NDArray[np.float64]:
     return np.where(touch.any(axis=1), (first + 1) * ROLLOUT_DT, math.inf)
 
 
-def _static_clear(paths: NDArray, static: NDArray, radius: float) -> NDArray[np.bool_]:
-    """Per path (c, k, 2): its first EVASION_COMMIT seconds keep radius + STATIC_MARGIN
-    from every static point (m, 2)."""
+def halted(pose: NDArray[np.float64], paths: NDArray[np.float64], static: NDArray,
+           radius: float) -> tuple[NDArray[np.float64], NDArray[np.int64]]:
+    """The paths (c, k, 2) from ``pose`` (x, y, yaw), each held from the first step that
+    comes within radius + STATIC_MARGIN [m] of a static point (m, 2) at its last point
+    before it (the start, for the first step): where the robot would stand, braked; and
+    that step's index per path (c,; k for a path that never comes that close)."""
+    c, k = paths.shape[:2]
     if len(static) == 0:
-        return np.ones(len(paths), bool)
-    near = paths[:, :_steps(EVASION_COMMIT)]
-    d2 = ((near[:, :, None, :] - static[None, None]) ** 2).sum(axis=-1)
-    return d2.min(axis=(1, 2)) >= (radius + STATIC_MARGIN) ** 2
+        return paths, np.full(c, k, np.int64)
+    d, _ = cKDTree(static).query(paths.reshape(-1, 2), distance_upper_bound=radius
+                                 + STATIC_MARGIN)
+    near = np.isfinite(d).reshape(c, k)
+    first = np.where(near.any(axis=1), np.argmax(near, axis=1), k)
+    if np.all(first == k):
+        return paths, first
+    start = np.broadcast_to(pose[:2], (c, 1, 2))
+    held = np.minimum(np.arange(k)[None], first[:, None] - 1) + 1   # index into start+paths
+    return np.take_along_axis(np.concatenate((start, paths), axis=1), held[..., None],
+                              axis=1), first
 
 
 def candidates(cfg: PlannerConfig) -> list[Escape]:
@@ -181,9 +195,9 @@ def evade(pose: NDArray[np.float64], planned: tuple[float, float], tracks: Track
         options.append(committed)
     v = np.array([e.v for e in options])
     turn = np.array([e.turn for e in options])
-    paths = rollouts(pose, v, turn)
+    paths, halt = halted(pose, rollouts(pose, v, turn), static, cfg.robot_radius)
     ok = ~((v > 0.0) & blocked_ahead)
-    ok &= (v == 0.0) | _static_clear(paths, static, cfg.robot_radius)
+    ok &= (v == 0.0) | (halt >= _steps(EVASION_COMMIT))
     if not np.any(ok):
         return None
     gaps = _gaps(paths, tracks, cfg.robot_radius)

@@ -201,13 +201,14 @@ class OccupancyGrid:
         mark[free] = 1
         mark[ends] = 2
         touched = np.flatnonzero(mark)
-        rows, cols = np.divmod(touched, c1 - c0)
-        window = self.log_odds[r0:r1, c0:c1]   # a view
-        old = window[rows, cols]
+        w = c1 - c0   # box flat index -> the window's (C-contiguous) flat index
+        cells = touched + (touched // w) * (n - w) + (r0 * n + c0)
+        log_odds = self.log_odds.reshape(-1)   # a view
+        old = log_odds[cells]
         new = np.minimum(np.maximum(
             old + np.where(mark[touched] == 2, np.float32(HIT), np.float32(MISS)),
             np.float32(LOG_ODDS_MIN)), np.float32(LOG_ODDS_MAX))
-        window[rows, cols] = new
+        log_odds[cells] = new
         if np.any((old > 0.0) != (new > 0.0)):
             self.version += 1
 

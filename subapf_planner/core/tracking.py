@@ -260,8 +260,10 @@ class Tracker:
         moving = (self.hits >= MIN_HITS) & (speed >= self.moving_speed) & (self.went >= went)
         held = moving | ((self.new_age >= 0) & (self.new_age < NEW_OBJECT_SCANS))
         point_track = track_of[labels] if count else np.zeros(0, np.int64)
-        trail = [pts[np.isin(ids, self.ids[held])] for ids, pts in self._history] \
-            if np.any(held) else []
+        # held[id] by track id; the last slot (id -1: a point of no track) stays False
+        held_by_id = np.zeros(self._next_id + 1, bool)
+        held_by_id[self.ids[held]] = True
+        trail = [pts[held_by_id[ids]] for ids, pts in self._history] if np.any(held) else []
         self._history = (self._history + [(np.where(point_track >= 0, self.ids[
             np.maximum(point_track, 0)] if len(self.ids) else -1, -1), points)])[-TRAIL_SCANS:]
         self._last = Tracks(self.x[:, :2].copy(), self.x[:, 2:].copy(), self.radius.copy(),
