@@ -14,13 +14,13 @@ would come within ``robot_radius + STATIC_MARGIN`` of a laser point that is not 
 moving track's (a robot that runs ahead of a walker into a wall stands there when
 the walker arrives), and it is admissible only if it does not halt within its
 first EVASION_COMMIT seconds and the safety corridor does not block its forward
-speed. Among the admissible ones that keep the clearance,
-the one closest to the planned command wins (the robot steps aside rather than
-turns back); when none keeps it, one that never touches a predicted disc within
-the horizon, else the one that touches latest, and among those the largest gap
-(it never stands still in an obstacle's way while a way out exists). Gaps are
-time-weighted so that a meeting soon counts more than one later. The chosen
-manoeuvre is committed: the next cycle considers it again, one period on.
+speed. Among the admissible ones that keep the clearance, the one closest to the
+planned command wins (the robot steps aside rather than turns back); when none
+keeps it, one that never touches a predicted disc within the horizon, else the one
+that touches latest, and among those the largest gap (it never stands still in an
+obstacle's way while a way out exists). Gaps are time-weighted so that a meeting
+soon counts more than one later. The chosen manoeuvre is committed: the next cycle
+considers it again, one period on.
 """
 
 from __future__ import annotations

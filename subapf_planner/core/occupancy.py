@@ -203,7 +203,7 @@ class OccupancyGrid:
         touched = np.flatnonzero(mark)
         w = c1 - c0   # box flat index -> the window's (C-contiguous) flat index
         cells = touched + (touched // w) * (n - w) + (r0 * n + c0)
-        log_odds = self.log_odds.reshape(-1)   # a view
+        log_odds = self.log_odds.reshape(-1)   # a view: allocated C-contiguous, kept so
         old = log_odds[cells]
         new = np.minimum(np.maximum(
             old + np.where(mark[touched] == 2, np.float32(HIT), np.float32(MISS)),
