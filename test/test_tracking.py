@@ -215,7 +215,6 @@ def test_escape_command_is_its_first_step():
     assert Escape(0.1, (0.5, 0.0)).advanced() == Escape(0.1, (0.0, 0.0))
 
 
-
 def test_a_rollout_halts_before_a_static_point():
     """Straight at 0.2 m/s towards a wall at x = 0.5: the rollout stands from the first
     step within robot_radius + STATIC_MARGIN of it at the point before; a path that
