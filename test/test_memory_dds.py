@@ -50,9 +50,10 @@ def test_bringup_drives_a_maze_and_publishes_map_and_plan(tmp_path, bringup_env)
     # a plan per new field, per 0.25 m driven or per second: at least one per 2 s of a
     # run of 25 s or more; its points 0.25 m apart (the last step may be shorter)
     assert len(plan) >= 12 and all(p.header.frame_id == 'odom' for p in plan)
-    for p in plan:
+    for p in plan:   # one pose only at the end: within 0.25 m of the goal, driving on
         xy = np.array([(q.pose.position.x, q.pose.position.y) for q in p.poses])
-        assert len(xy) >= 2 and np.all(np.hypot(*np.diff(xy[:-1], axis=0).T) >= 0.25 - 1e-6)
+        assert len(xy) >= 1 and np.all(np.hypot(*np.diff(xy[:-1], axis=0).T) >= 0.25 - 1e-6)
+    assert all(len(p.poses) >= 2 for p in plan[:len(plan) // 2])   # far from the goal
     # the map at map_rate (1 Hz of the simulated clock) at most, to the nearest planning
     # tick (5 Hz: a message is due from half a tick before its period is up)
     stamps = [m.header.stamp.sec + 1e-9 * m.header.stamp.nanosec

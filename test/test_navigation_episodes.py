@@ -103,3 +103,22 @@ def test_a_robot_that_stops_believing_it_is_there_has_missed():
     assert result.outcome is Outcome.MISSED
     assert result.final_distance == pytest.approx(3.0 - 3.0 / 1.3, abs=0.2)
     assert result.time_s < 60.0
+
+
+@pytest.mark.core
+def test_a_run_is_judged_where_the_robot_stops():
+    """The bench's judge (sim/outcome.py): passing through the goal's tolerance is not
+    reaching it; stopping inside is, stopping outside is `missed`; sim_node, which does
+    not hear the planner, reports `reached` on the first touch."""
+    from subapf_planner.sim.outcome import outcome_of
+    world = parse_world({'name': 'open', 'start': [0.0, 0.0, 0.0], 'goal': [3.0, 0.0],
+                         'time_limit': 120, 'obstacles': []})
+    inside, outside = (2.9, 0.0, 0.0), (2.7, 0.0, 0.0)
+    assert outcome_of(world, inside, False, 10.0, stopped_at_goal=False) is None
+    assert outcome_of(world, inside, False, 10.0, stopped_at_goal=True) is Outcome.REACHED
+    assert outcome_of(world, outside, False, 10.0, stopped_at_goal=True) is Outcome.MISSED
+    assert outcome_of(world, inside, False, 10.0) is Outcome.REACHED       # sim_node
+    assert outcome_of(world, outside, True, 10.0, stopped_at_goal=False) \
+        is Outcome.COLLISION
+    assert outcome_of(world, outside, False, 120.0, stopped_at_goal=False) \
+        is Outcome.TIMEOUT

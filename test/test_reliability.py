@@ -241,6 +241,27 @@ def test_goal_inside_obstacle_stops_with_reason():
     assert d.command == (0.0, 0.0) and d.text == 'stopped: goal_in_obstacle'
 
 
+def test_a_goal_inside_an_obstacle_is_given_up_like_an_unreachable_one():
+    """goal_in_obstacle (a goal inside a wall of a drifted memory, or someone standing
+    on it) does not hold the robot until the time limit: with goal_unreachable in turn,
+    unreachable_timeout of them ends the attempt; the clock does not restart between
+    the two."""
+    ctl = DecisionLoop(CFG, Supervision(unreachable_timeout=3.0))
+    ctl.set_goal(np.array([5.0, 0.0]))
+    script = iter([Status.GOAL_IN_OBSTACLE, Status.GOAL_UNREACHABLE] * 20)
+    ctl.planner.step = lambda *a, **k: PlanResult(Command(0.0, 0.0, next(script)))
+    scan = Scan(np.full(360, np.inf), 0.0, math.pi / 180, 0.12, 3.5, 0.0)
+    texts = []
+    for k in range(20):   # ticks 0.25 s apart
+        ctl.update_scan(scan, 0.25 * k)
+        ctl.update_odom(0.25 * k, np.zeros(3), 0.25 * k)
+        texts.append(ctl.tick(0.25 * k).text)
+    assert texts[0] == 'stopped: goal_in_obstacle'
+    given_up = next(k for k, t in enumerate(texts) if t.startswith('unreachable'))
+    assert given_up == 13                       # more than 3 s since tick 0
+    assert ctl.state is State.UNREACHABLE
+
+
 def test_goal_equal_to_start_is_reached_at_once():
     ctl = DecisionLoop(CFG)
     ctl.set_goal(np.array([0.0, 0.0]))

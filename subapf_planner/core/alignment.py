@@ -23,9 +23,12 @@ as Hector SLAM's, with point-to-line residuals as in ICP), where
 * acceptance only when at least MIN_MATCHED returns take part and the step from
   the prediction is below MAX_STEP_XY / MAX_STEP_YAW (drift between two scans
   is millimetres; a bigger step is a wrong match). Otherwise the prediction
-  stands; it also stands when the match moves it less than DEADBAND_XY and
-  DEADBAND_YAW (the matcher's own error on a map it builds as it goes would
-  otherwise walk the pose away from perfect odometry).
+  stands.
+
+What the planner takes of a match is bounded by how far odometry can have drifted
+since the last one (within_drift: DRIFT_* per metre driven and radian turned):
+standing still nothing moves the pose, neither a person walking past nor the
+matcher's own error on a map it builds as it goes.
 
 Pure numpy/scipy, arrays in and out, nothing kept between calls.
 """
@@ -58,14 +61,15 @@ PRIOR_SIGMA_YAW = 0.02
 #: Standard deviation of one return's distance to the wall [m] (the laser's noise plus
 #: half a cell).
 RETURN_SIGMA = 0.03
-#: A match that moves the prediction less than this (both) leaves it [m], [rad]: the
-#: matcher's own error (a map built as it goes) does not walk the pose, while drift,
-#: which grows, is corrected once it is this large.
-DEADBAND_XY = 0.015
-DEADBAND_YAW = 0.01
 #: A match that moves the prediction more than this is refused [m], [rad].
 MAX_STEP_XY = 0.03
 MAX_STEP_YAW = 0.03
+#: Drift the wheels can add, per metre driven and per radian turned, and so the most a
+#: match may move the prediction since the last scan [m/m], [m/rad], [rad/m], [rad/rad].
+DRIFT_XY_PER_M = 0.05
+DRIFT_XY_PER_RAD = 0.01
+DRIFT_YAW_PER_M = 0.02
+DRIFT_YAW_PER_RAD = 0.05
 
 
 @dataclass(frozen=True)
@@ -138,6 +142,24 @@ def distance_field(log_odds: NDArray[np.float32], origin: NDArray[np.float64],
                          resolution)
 
 
+def within_drift(predicted: NDArray[np.float64], matched: NDArray[np.float64],
+                 driven: float, turned: float) -> NDArray[np.float64]:
+    """The matched pose (x, y, yaw) moved back towards the ``predicted`` one so that the
+    correction changes no more than odometry can have drifted since the last scan,
+    ``driven`` [m] and ``turned`` [rad] ago (DRIFT_*): standing still, odometry does not
+    drift, and nothing (a person walking past, the matcher's own error) moves the pose."""
+    off = np.asarray(matched, float) - predicted
+    off[2] = math.remainder(off[2], 2 * math.pi)
+    turned = abs(turned)
+    limit_xy = DRIFT_XY_PER_M * driven + DRIFT_XY_PER_RAD * turned
+    limit_yaw = DRIFT_YAW_PER_M * driven + DRIFT_YAW_PER_RAD * turned
+    shift = math.hypot(off[0], off[1])
+    if shift > limit_xy:
+        off[:2] *= limit_xy / shift
+    off[2] = min(max(off[2], -limit_yaw), limit_yaw)
+    return np.asarray(predicted, float) + off
+
+
 @dataclass(frozen=True)
 class Match:
     """An alignment: the pose (x, y, yaw) of base_footprint, whether it was accepted
@@ -189,6 +211,4 @@ def align(base_points: NDArray[np.float64], predicted: NDArray[np.float64],
     shift = float(np.hypot(off[0], off[1]))
     ok = matched >= MIN_MATCHED and shift <= MAX_STEP_XY and abs(off[2]) <= MAX_STEP_YAW
     rms = float(np.sqrt(np.mean(d[use] ** 2))) if matched else math.nan
-    if ok and shift < DEADBAND_XY and abs(off[2]) < DEADBAND_YAW:
-        return Match(prior, True, matched, rms)   # agrees with the prediction
     return Match(pose if ok else prior, bool(ok), matched, rms)

@@ -86,6 +86,13 @@ class PlannerConfig:
     rotate_in_place_angle: float = param(0.9, 'Turn on the spot when the heading error '
                                           'exceeds this', 'rad', 0.0, math.pi)
     goal_tolerance: float = param(0.15, 'xy goal tolerance; stop inside it', 'm', 0.01, 5.0)
+    arrival_distance: float = param(0.05, 'With the geodesic field: once inside '
+                                    'goal_tolerance, drive on towards the goal until this '
+                                    'close, or until a cycle brings it no closer (so that '
+                                    'a pose error of a few centimetres, drift the scan '
+                                    'alignment has not yet corrected, still leaves the '
+                                    'robot inside the tolerance); goal_tolerance or more: '
+                                    'stop on entering it', 'm', 0.0, 5.0)
     slowdown_distance: float = param(0.4, 'Speed scales down linearly inside this distance '
                                       'of the goal', 'm', 0.0, 10.0)
     robot_radius: float = param(BURGER.radius, 'Robot radius: half-width of the forward safety '

@@ -10,7 +10,8 @@ Each ``tick`` supervises (goal, freshness, progress) and runs one planning step
 
 States (:class:`~.status.State`, the text of ``~/status`` before the colon):
 idle, waiting, driving, reached, stopped, stuck (the progress checker gave the
-goal up), unreachable (no way through the memory for ``unreachable_timeout``).
+goal up), unreachable (no way through the memory, or the goal inside an obstacle,
+for ``unreachable_timeout``).
 """
 
 from __future__ import annotations
@@ -37,6 +38,11 @@ POSE_MATCH = 0.1
 GIVING_WAY_DISTANCE = 2.0
 
 
+#: Statuses under which the goal cannot be reached for now; unreachable_timeout of them
+#: ends the attempt.
+NO_WAY = (Status.GOAL_UNREACHABLE, Status.GOAL_IN_OBSTACLE)
+
+
 @dataclass(frozen=True)
 class Supervision:
     """Limits of the decision loop (config/planner.yaml, supervision section)."""
@@ -57,10 +63,11 @@ class Supervision:
     avoid_time: float = param(60.0, 'How long a tried place stays blocked in the field (then '
                               'it opens again: a door that was only briefly blocked)', 's',
                               1.0, 3600.0)
-    unreachable_timeout: float = param(30.0, 'A goal unreachable through the memory this '
-                                       'long ends the attempt (state unreachable); a way '
-                                       'that opens before (a door, someone who walked '
-                                       'off) restarts the clock', 's', 1.0, 3600.0)
+    unreachable_timeout: float = param(30.0, 'A goal unreachable through the memory, or '
+                                       'inside an obstacle, this long ends the attempt '
+                                       '(state unreachable); a way that opens before (a '
+                                       'door, someone who walked off) restarts the clock',
+                                       's', 1.0, 3600.0)
 
     def __post_init__(self) -> None:
         check_fields(self)
@@ -238,9 +245,10 @@ class DecisionLoop:
         return self._stop(State.STUCK, 'no progress, goal abandoned', result)
 
     def _unreachable_too_long(self, status: Status, now: float) -> bool:
-        """Whether ``goal_unreachable`` has lasted longer than unreachable_timeout
+        """Whether ``goal_unreachable`` or ``goal_in_obstacle`` (NO_WAY: a goal the
+        robot cannot stand at is no nearer) has lasted longer than unreachable_timeout
         (any other status restarts the clock)."""
-        if status is not Status.GOAL_UNREACHABLE:
+        if status not in NO_WAY:
             self._unreachable_since = None
             return False
         if self._unreachable_since is None:

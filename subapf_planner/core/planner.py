@@ -37,7 +37,7 @@ import math
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from .alignment import Match
+from .alignment import Match, within_drift
 from .apf import apf_step
 from .command import Command, forward_blocked, shape_command
 from .config import PlannerConfig
@@ -57,6 +57,9 @@ _EMPTY = np.zeros((0, 2))
 AVOID_AHEAD = 0.5
 #: ... a disc of this radius [m] (a door and its sides).
 AVOID_RADIUS = 0.35
+#: Inside goal_tolerance, a cycle that brings the robot less than this closer to the goal
+#: ends the approach (it cannot get closer: arrival_distance) [m].
+ARRIVAL_PROGRESS = 0.002
 
 
 @dataclass(frozen=True)
@@ -199,6 +202,7 @@ class Planner:
         self.memory = NavigationMemory(cfg)
         self.tracker = _tracker(cfg)
         self._escape: Escape | None = None   # the escape of the last cycle, if it evaded
+        self._approach: tuple[NDArray, float] | None = None   # last cycle's goal, distance
         self._clear_alignment()
 
     @property
@@ -223,6 +227,7 @@ class Planner:
         self.reset()
         self.memory.forget()
         self.tracker.reset()
+        self._approach = None
         self._clear_alignment()
 
     def _clear_alignment(self) -> None:
@@ -230,6 +235,7 @@ class Planner:
         self.correction: tuple[float, float, float] = (0.0, 0.0, 0.0)
         self.match: Match | None = None          # the last scan's alignment
         self._aligned_stamp: float | None = None
+        self._aligned_from: NDArray | None = None   # odom pose of the last scan matched
         self._goal: tuple[NDArray, NDArray] | None = None   # (in odom, in the memory's frame)
         self._planned_from: NDArray | None = None   # the last cycle's pose (memory's frame)
 
@@ -268,6 +274,9 @@ class Planner:
             self.memory.integrate(scan, scan_pose, goal, transient)
         seen = _situation(pose, goal, points)
         status = goal_status(cfg, seen['goal_distance'], goal, seen['obstacles'])
+        if status is Status.REACHED and self._drives_on(goal, seen['goal_distance']):
+            status = None
+        self._approach = (goal, seen['goal_distance'])
         field, new_field = None, False
         if status is None and cfg.geodesic:   # the goal through the memory
             field = self.memory.field_for(pose[:2], goal, now)
@@ -292,6 +301,18 @@ class Planner:
         self.previous = (result.command.v, result.command.w)
         return result
 
+    def _drives_on(self, goal: NDArray, distance: float) -> bool:
+        """Inside goal_tolerance at ``distance`` [m] from ``goal``: whether to drive on
+        (geodesic only): farther than arrival_distance and at least ARRIVAL_PROGRESS
+        closer than the last cycle, or its first cycle inside."""
+        cfg = self.cfg
+        if not cfg.geodesic or distance <= cfg.arrival_distance:
+            return False
+        if self._approach is None or not np.array_equal(self._approach[0], goal):
+            return True
+        before = self._approach[1]
+        return before > cfg.goal_tolerance or before - distance >= ARRIVAL_PROGRESS
+
     def avoid_ahead(self, until: float) -> bool:
         """Mark the place the navigation field leads the robot into next (AVOID_AHEAD
         along its descent from the last cycle's pose, a disc of AVOID_RADIUS) as tried,
@@ -314,14 +335,21 @@ class Planner:
 
     def _align(self, scan: Scan, scan_pose: NDArray) -> None:
         """Match a new scan (not one already matched: same stamp) to the memory and
-        update the correction when the match is accepted (core/alignment.py)."""
+        update the correction when the match is accepted, by no more than odometry can
+        have drifted since the last scan (core/alignment.py: within_drift)."""
         if scan.stamp == self._aligned_stamp:
             return
         self._aligned_stamp = scan.stamp
         predicted = self.in_map(scan_pose)
         self.match = self.memory.align(scan, predicted, self._moving_discs(scan.stamp))
-        if self.match.accepted and not np.array_equal(self.match.pose, predicted):
-            self.correction = compose(self.match.pose, invert(scan_pose))
+        last, self._aligned_from = self._aligned_from, scan_pose
+        if not self.match.accepted or last is None:
+            return
+        moved = compose(invert(last), scan_pose)   # odometry's motion since the last scan
+        pose = within_drift(predicted, self.match.pose, math.hypot(moved[0], moved[1]),
+                            moved[2])
+        if not np.array_equal(pose, predicted):
+            self.correction = compose(pose, invert(scan_pose))
 
     def _moving_discs(self, t: float) -> tuple[NDArray, NDArray]:
         """Where the last scan's tracks that move, are held out of the memory or seem to

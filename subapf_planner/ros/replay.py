@@ -5,7 +5,9 @@ checks (ros/intake.py) and the same ``DecisionLoop`` the node runs, in simulated
 time order (as fast as possible; the event stream of bag/events.py, which the
 DDS replay, ros/replay_dds.py, reads too); at each recorded ``cmd_vel`` the loop
 ticks, as the node's timer did: at its stamp (TwistStamped) or, for a Twist bag,
-at the simulated time it was recorded at.
+at the simulated time it was recorded at. A recorded zero while the loop has no goal
+and nothing to say (the goal reached or given up) is the node stopping the robot as
+it shuts down, and is compared as the zero it is.
 """
 
 from __future__ import annotations
@@ -50,7 +52,11 @@ def replay(path: str, cfg: PlannerConfig, limits: Supervision, names: dict[str, 
                 ctl.seed_command(command)   # the node's state after what it published
             times.append(t)
             recorded.append(command)
-            replayed.append(decision.command if decision.command is not None
-                            else (math.nan, math.nan))
+            if decision.command is not None:
+                replayed.append(decision.command)
+            elif ctl.goal is None and command == (0.0, 0.0):
+                replayed.append((0.0, 0.0))   # the node's stop on shutdown
+            else:
+                replayed.append((math.nan, math.nan))
     return Comparison(np.asarray(times), np.asarray(recorded, float).reshape(-1, 2),
                       np.asarray(replayed, float).reshape(-1, 2), skipped)

@@ -16,6 +16,7 @@ A world with moving obstacles also gets ``moving_obstacles``
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
+import math
 import sys
 
 from geometry_msgs.msg import Twist, TwistStamped
@@ -48,6 +49,9 @@ from .spinning import spin_node
 #: Simulated time per timer tick [s]; odometry and /clock go out every tick.
 TICK = 0.05
 SCAN_PERIOD = 0.2
+#: After ``reached`` the simulation goes on while the robot is commanded to move (the
+#: planner drives on inside the tolerance to arrival_distance), at most this long [s].
+ARRIVAL_TIME = 10.0
 #: REP-105 frames of the burger: base_link above base_footprint, base_scan in base_link.
 BASE_LINK_HEIGHT = ROBOT.base_link_height
 LASER_IN_BASE_LINK = (ROBOT.laser.x, ROBOT.laser.y, ROBOT.laser.z - BASE_LINK_HEIGHT)
@@ -97,6 +101,8 @@ class SimNode(Node):
         cmd_type = TwistStamped if options.enable_stamped_cmd_vel else Twist
         self.create_subscription(cmd_type, 'cmd_vel', self._on_cmd, 10)
         self.outcome: Outcome | None = None
+        self._outcome_time = math.inf
+        self._commanded = (0.0, 0.0)   # the last cmd_vel (v, w)
         self._next_scan = 0.0
         # Fast mode: several ticks per timer callback, so the executor's overhead per
         # callback does not cap the speed-up.
@@ -124,7 +130,8 @@ class SimNode(Node):
             transform_msg('base_link', 'base_scan', LASER_IN_BASE_LINK, 0.0, 0.0)]))
 
     def _on_cmd(self, msg: Twist | TwistStamped) -> None:
-        self.sim.set_command(*cmd_from_msg(msg))
+        self._commanded = tuple(cmd_from_msg(msg))
+        self.sim.set_command(*self._commanded)
 
     def _on_timer(self) -> None:
         for _ in range(self.ticks_per_call):
@@ -132,7 +139,7 @@ class SimNode(Node):
 
     def _on_tick(self) -> None:
         sim = self.sim
-        if self.outcome is None:
+        if self._running():
             sim.step(TICK)
         t = sim.time
         pose, twist = sim.odometry()
@@ -157,6 +164,14 @@ class SimNode(Node):
         if self.outcome is None:
             self._check_outcome()
 
+    def _running(self) -> bool:
+        """Whether the simulation steps: until the outcome, and after ``reached`` while
+        the robot is still commanded to move, ARRIVAL_TIME at most."""
+        if self.outcome is None:
+            return True
+        return self.outcome is Outcome.REACHED and self._commanded != (0.0, 0.0) \
+            and self.sim.time < self._outcome_time + ARRIVAL_TIME
+
     def close(self) -> None:
         """Release the physics server."""
         self.sim.close()
@@ -165,6 +180,7 @@ class SimNode(Node):
         sim = self.sim
         self.outcome = outcome_of(self.world, sim.true_pose(), sim.collided, sim.time)
         if self.outcome is not None:
+            self._outcome_time = sim.time
             self.outcome_pub.publish(String(data=str(self.outcome)))
             stood = ' (hit while stopped)' if sim.collided and sim.hit_while_stopped else ''
             self.get_logger().info(f'outcome: {self.outcome}{stood} at t={sim.time:.1f} s')

@@ -24,6 +24,9 @@ from .spinning import stop_on_signals
 
 #: Depth of the recording subscriptions: deep enough that a busy recorder loses nothing.
 RECORD_DEPTH = 500
+#: Once the simulator reports the goal reached, how long the run goes on while the
+#: planner still drives (arrival_distance: it drives on inside the tolerance) [s, wall].
+ARRIVAL_WAIT = 10.0
 _SENSOR = QoSProfile(depth=RECORD_DEPTH, reliability=ReliabilityPolicy.BEST_EFFORT)
 _RELIABLE = QoSProfile(depth=RECORD_DEPTH)
 _LATCHED_DEEP = QoSProfile(depth=RECORD_DEPTH, durability=DurabilityPolicy.TRANSIENT_LOCAL)
@@ -105,10 +108,12 @@ class Supervisor:
 
     def run(self, children: list[subprocess.Popen], timeout: float,
             names: tuple[str, ...] = ()) -> str:
-        """Spin until the simulator reports an outcome, a child dies, or the timeout.
+        """Spin until the simulator reports an outcome (for ``reached``: and the planner
+        has stopped driving, or ARRIVAL_WAIT later), a child dies, or the timeout.
         Samples each named child's resident memory once a second into ``rss_mib``."""
         deadline = time.monotonic() + timeout
         goal_sent_at = None
+        arrived_at = None
         next_sample = time.monotonic()
         while time.monotonic() < deadline:
             if self.stop.is_set():
@@ -118,6 +123,10 @@ class Supervisor:
                 for name, child in zip(names, children, strict=True):
                     self.rss_mib.setdefault(name, []).append(rss_mib(child.pid))
             rclpy.spin_once(self.node, timeout_sec=0.05)
+            if self.outcome == 'reached' and self.status.startswith('driving'):
+                arrived_at = arrived_at or time.monotonic()   # it drives on to the goal
+                if time.monotonic() - arrived_at < ARRIVAL_WAIT:
+                    continue
             if self.outcome is not None:
                 return self.outcome
             dead = [c for c in children if c.poll() is not None]

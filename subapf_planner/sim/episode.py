@@ -81,11 +81,12 @@ class EpisodeResult:
 def run_episode(world: World, cfg: PlannerConfig, sim_cfg: SimConfig | None = None,
                 time_limit: float | None = None, faults: ScanFaults | None = None,
                 limits: Supervision | None = None, label: str | None = None) -> EpisodeResult:
-    """Drive the world's start to its goal; stop at the first outcome, or when the
-    planner gives the goal up (``abandoned``: the progress checker; ``unreachable``:
-    no way through its memory for ``unreachable_timeout``) or stops at the goal by
-    its own estimate while the truth is outside the tolerance (``missed``). ``label``
-    names the method in the result (default ``cfg.method``)."""
+    """Drive the world's start to its goal until the planner stops there by its own
+    estimate (``reached`` when the truth is inside the world's tolerance then,
+    ``missed`` when it is not: outcome_of), gives the goal up (``abandoned``: the
+    progress checker; ``unreachable``: no way through its memory for
+    ``unreachable_timeout``), collides or runs out of time. ``label`` names the method
+    in the result (default ``cfg.method``)."""
     sim_cfg = sim_cfg or SimConfig()
     delivery: ScanDelivery[Scan] = ScanDelivery(faults or ScanFaults(),
                                                 sim_cfg.seed + FAULT_SEED_OFFSET)
@@ -98,11 +99,10 @@ def run_episode(world: World, cfg: PlannerConfig, sim_cfg: SimConfig | None = No
             truth = sim.true_pose()
             path.append(truth)
             times.append(sim.time)
-            outcome = outcome_of(world, truth, sim.collided, sim.time, time_limit)
+            outcome = outcome_of(world, truth, sim.collided, sim.time, time_limit,
+                                 stopped_at_goal=ctl.state is State.REACHED)
             if outcome is None and ctl.state.gave_up:
                 outcome = GAVE_UP[ctl.state]
-            if outcome is None and ctl.state is State.REACHED:
-                outcome = Outcome.MISSED   # it stopped, believing it was there
             if outcome is not None:
                 break
             now = sim.time

@@ -1,0 +1,56 @@
+"""Arrival (core/planner.py, arrival_distance): inside goal_tolerance the default
+drives on towards the goal while a cycle still brings it closer, so that a pose error
+of a few centimetres leaves the robot inside the tolerance; the paper's method stops
+on entering it."""
+
+import math
+
+import numpy as np
+import pytest
+
+from subapf_planner.core.config import PlannerConfig
+from subapf_planner.core.planner import Planner
+from subapf_planner.core.scan import Scan
+from subapf_planner.core.status import Status
+
+pytestmark = pytest.mark.core
+
+OPEN = np.full(360, np.inf)   # nothing in range
+
+
+def step(planner, pose, goal, k):
+    return planner.step(np.asarray(pose, float), goal,
+                        Scan(OPEN, 0.0, 2 * math.pi / 360, 0.12, 3.5, float(k)),
+                        now=float(k))
+
+
+def test_inside_the_tolerance_it_drives_on_while_it_gets_closer():
+    cfg = PlannerConfig()
+    planner = Planner(cfg)
+    goal = (1.0, 0.0)
+    res = step(planner, (1.0 - 0.12, 0.0, 0.0), goal, 0)     # inside the tolerance
+    assert 0.12 < cfg.goal_tolerance
+    assert res.command.status is not Status.REACHED and res.command.v > 0.0
+    res = step(planner, (1.0 - 0.11, 0.0, 0.0), goal, 1)     # 1 cm closer: on
+    assert res.command.status is not Status.REACHED and res.command.v > 0.0
+    res = step(planner, (1.0 - 0.11, 0.0, 0.0), goal, 2)     # no closer: there
+    assert res.command.status is Status.REACHED and res.command.v == 0.0
+    res = step(planner, (1.0 - 0.04, 0.0, 0.0), goal, 3)     # within arrival_distance
+    assert 0.04 < cfg.arrival_distance and res.command.status is Status.REACHED
+
+
+def test_a_new_goal_starts_a_new_approach():
+    planner = Planner(PlannerConfig())
+    step(planner, (0.88, 0.0, 0.0), (1.0, 0.0), 0)
+    step(planner, (0.89, 0.0, 0.0), (1.0, 0.0), 1)
+    res = step(planner, (0.89, 0.0, 0.0), (1.0, 0.01), 2)    # another goal, no closer
+    assert res.command.status is not Status.REACHED
+
+
+@pytest.mark.parametrize('cfg', [PlannerConfig(arrival_distance=0.15),
+                                 PlannerConfig(method='subharmonic_sampling',
+                                               attraction_field='euclidean')],
+                         ids=['arrival at the tolerance', 'paper'])
+def test_without_it_the_robot_stops_on_entering_the_tolerance(cfg):
+    res = step(Planner(cfg), (1.0 - 0.12, 0.0, 0.0), (1.0, 0.0), 0)
+    assert res.command.status is Status.REACHED and res.command.v == 0.0
