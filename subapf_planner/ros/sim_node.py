@@ -102,7 +102,6 @@ class SimNode(Node):
         self.create_subscription(cmd_type, 'cmd_vel', self._on_cmd, 10)
         self.outcome: Outcome | None = None
         self._outcome_time = math.inf
-        self._commanded = (0.0, 0.0)   # the last cmd_vel (v, w)
         self._next_scan = 0.0
         # Fast mode: several ticks per timer callback, so the executor's overhead per
         # callback does not cap the speed-up.
@@ -130,8 +129,7 @@ class SimNode(Node):
             transform_msg('base_link', 'base_scan', LASER_IN_BASE_LINK, 0.0, 0.0)]))
 
     def _on_cmd(self, msg: Twist | TwistStamped) -> None:
-        self._commanded = tuple(cmd_from_msg(msg))
-        self.sim.set_command(*self._commanded)
+        self.sim.set_command(*cmd_from_msg(msg))
 
     def _on_timer(self) -> None:
         for _ in range(self.ticks_per_call):
@@ -166,10 +164,11 @@ class SimNode(Node):
 
     def _running(self) -> bool:
         """Whether the simulation steps: until the outcome, and after ``reached`` while
-        the robot is still commanded to move, ARRIVAL_TIME at most."""
+        the robot is still commanded to move (the simulator's own command: zero once
+        it is older than cmd_timeout), ARRIVAL_TIME at most."""
         if self.outcome is None:
             return True
-        return self.outcome is Outcome.REACHED and self._commanded != (0.0, 0.0) \
+        return self.outcome is Outcome.REACHED and self.sim.wheel_command() != (0.0, 0.0) \
             and self.sim.time < self._outcome_time + ARRIVAL_TIME
 
     def close(self) -> None:

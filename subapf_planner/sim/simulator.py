@@ -186,7 +186,7 @@ class BurgerSim:
         self._cmd = (v, w)
         self._cmd_time = self.time
 
-    def _wheel_command(self) -> tuple[float, float]:
+    def wheel_command(self) -> tuple[float, float]:
         """The (v, w) the base drives: the last command, or zero after cmd_timeout."""
         if self.time - self._cmd_time > self.config.cmd_timeout:
             return 0.0, 0.0
@@ -195,7 +195,7 @@ class BurgerSim:
     def _apply_wheels(self) -> None:
         """The wheel motors' target velocities for the base's (v, w), sent when they
         change (PyBullet keeps a motor's target until it is set again)."""
-        v, w = self._wheel_command()
+        v, w = self.wheel_command()
         targets = ((v - w * ROBOT.wheel_separation / 2) / ROBOT.wheel_radius,
                    (v + w * ROBOT.wheel_separation / 2) / ROBOT.wheel_radius)
         if targets != self._wheels_sent:
@@ -230,7 +230,7 @@ class BurgerSim:
                 self._integrate_odom()
             if not self.collided and self._touching_obstacle():
                 self.collided = True
-                self.hit_while_stopped = self._wheel_command() == (0.0, 0.0)
+                self.hit_while_stopped = self.wheel_command() == (0.0, 0.0)
         if perfect:
             self._odom = None   # the true pose, read when asked
 
