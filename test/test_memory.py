@@ -76,7 +76,7 @@ def test_memory_stays_bounded_on_a_long_drive():
         robot = grid.cell_of([x, 0.0])[0]
         assert grid.inside(robot[None])[0]
     assert grid.nbytes == size == 400 * 400 * 4   # log odds (no scan alignment)
-    assert OccupancyGrid(0.05, 20.0, hit_places=True).nbytes == 400 * 400 * (4 + 8 + 2)
+    assert OccupancyGrid(0.05, 20.0, hit_places=True).nbytes == 400 * 400 * (4 + 8 + 2 + 4)
     # only what is near the robot is remembered
     assert grid.centre_of(np.argwhere(grid.occupied()))[:, 0].min() > 200.0 - 20.0
 

@@ -86,6 +86,28 @@ def test_a_walker_where_the_memory_saw_free_space_is_known_to_move_sooner():
     assert on_unknown >= MOVE_DISTANCE / 0.22 > on_free
 
 
+def test_people_side_by_side_on_seen_free_cells_are_tracked_a_wall_is_not():
+    """Two walkers shoulder to shoulder (one cluster 1.5 m long: longer than
+    max_mover_size) on cells the memory saw free are tracked and found moving; the same
+    cluster on unknown cells is a wall, and so is one longer than NEW_SIZE_FACTOR times
+    max_mover_size."""
+    from subapf_planner.core.tracking import NEW_SIZE_FACTOR
+
+    def tracked(log_odds, length=1.5):
+        tr = Tracker(0.15, 1.2, 0.6, 0.04)
+        for k in range(12):
+            t = 0.2 * k
+            y = np.linspace(-length / 2, length / 2, 60)
+            pts = np.column_stack((3.0 - 0.2 * t + 0.1 * np.abs(y), y))   # a bent front
+            tracks = tr.update(pts, t, np.full(len(pts), log_odds))
+        return tracks
+
+    together = tracked(-1.0)
+    assert len(together.position) == 1 and together.moving.all()
+    assert len(tracked(0.0).position) == 0
+    assert len(tracked(-1.0, 1.2 * NEW_SIZE_FACTOR + 0.2).position) == 0
+
+
 def scan_of(robot, discs=(), walls=()):
     """Ranges of a 360-beam laser at ``robot`` (laser at the origin of base_footprint is
     not the burger's: the test planner uses laser_x = 0) seeing discs and straight walls

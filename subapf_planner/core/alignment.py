@@ -16,10 +16,20 @@ as Hector SLAM's, with point-to-line residuals as in ICP), where
   along it), the wall point being where the returns fell in that cell
   (OccupancyGrid.hit_offset), not its centre;
 * returns farther than MAX_CORRESPONDENCE from every wall left out (something
-  new: a wall not yet in the map, a person, the other face of a thin wall);
+  new: a wall not yet in the map, a person, the other face of a thin wall), and
+  so are returns beyond a wall where the memory's wall stops but the wall may go
+  on (:func:`_ends`: unknown, not seen-free, beyond; their nearest wall point
+  would pull the pose back along the wall) or off the wall along it
+  (:func:`_beside`);
 * a prior towards the odometry prediction (PRIOR_SIGMA_XY, PRIOR_SIGMA_YAW per
   scan), so that a corridor, which fixes the pose across it but not along it,
   keeps odometry's estimate along it;
+* among people: the returns of a piece of the scan no longer than a mover
+  (core/tracking.clusters) match only cells that have been walls for
+  MIN_WALL_SCANS (someone who walked slowly into the memory before the tracker
+  knew it moved has not stood that long where it is seen now), and a match needs
+  MIN_PIECES landmarks (:func:`landmarks`: one person-sized thing cannot tell a
+  walker from the robot's own drift);
 * acceptance only when at least MIN_MATCHED returns take part and the step from
   the prediction is below MAX_STEP_XY / MAX_STEP_YAW (drift between two scans
   is millimetres; a bigger step is a wrong match). Otherwise the prediction
@@ -42,14 +52,32 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy import ndimage
 
+from .occupancy import ESTABLISHED
 from .robot import to_parent
 
-#: Log odds from which a cell is an obstacle the matcher trusts (three hits).
-ESTABLISHED = 2.0
+#: A piece of the scan no longer than a mover (a person, a chair, a post) is matched only
+#: to cells established this many scans ago or more (5 s at the LDS-01's 5 Hz): a person
+#: who walked slowly into the memory, before the tracker knew it moved, has not stood
+#: that long where it is seen now. Walls (longer pieces) match at once: a room's walls
+#: must correct the pose from the first scans, or the room is drawn with the drift.
+MIN_WALL_SCANS = 25
 #: Returns farther than this from every established cell take no part [m].
 MAX_CORRESPONDENCE = 0.06
+#: A return farther than this along the wall from its nearest wall point takes no part
+#: (it is beyond the wall's end) [cells].
+ALONG_WALL = 0.75
+#: A wall cell is a wall's end when no wall lies this far along it on one side [cells]
+#: (_ends).
+END_PROBE = 2.0
 #: Fewest returns that must take part for a match to count.
 MIN_MATCHED = 40
+#: A piece of the scan (a cluster of returns: core/tracking.clusters) counts as a
+#: landmark of a match with at least this many matched returns ...
+MIN_PIECE_MATCHED = 8
+#: ... and a match needs this many landmarks, or one longer than a mover can be: a single
+#: mover-sized thing cannot tell a person standing (or walking slowly, written into the
+#: memory before it was known to move) from the robot's own drift.
+MIN_PIECES = 2
 #: Gauss-Newton iterations at most, and the step below which it stops [m, rad].
 ITERATIONS = 6
 CONVERGED = 5e-4
@@ -83,22 +111,71 @@ class DistanceField:
     normal: NDArray[np.float64]
     origin: NDArray[np.float64]
     resolution: float
+    #: Per cell (h, w): its nearest wall cell is where the memory's wall ends but the wall
+    #: may go on (:func:`_ends`).
+    end: NDArray[np.bool_] | None = None
+    #: Per cell (h, w): the scan from which its nearest wall cell has been established
+    #: (OccupancyGrid.established_at), and the grid's scan count when the field was made.
+    since: NDArray[np.int32] | None = None
+    scans: int = 0
 
-    def at(self, points: NDArray[np.float64]) -> tuple[NDArray, NDArray, NDArray]:
-        """Per point (n, 2): the nearest wall point (n, 2), the wall's normal there (n, 2),
-        and the distance (n,) [m]; inf outside the window."""
+    def _cells(self, points: NDArray[np.float64]) -> tuple[NDArray, NDArray, NDArray]:
+        """Which points (n, 2) lie in the window (n,), and the row and column of those."""
         cells = np.floor((points - self.origin) / self.resolution).astype(np.int64)
         h, w = self.values.shape
         inside = (cells[:, 0] >= 0) & (cells[:, 1] >= 0) & (cells[:, 0] < w) \
             & (cells[:, 1] < h)
+        return inside, cells[inside, 1], cells[inside, 0]
+
+    def young(self, points: NDArray[np.float64]) -> NDArray[np.bool_]:
+        """Per point (n, 2): its nearest wall cell has been established for fewer than
+        MIN_WALL_SCANS scans (False outside the window or without ``since``)."""
+        out = np.zeros(len(points), bool)
+        if self.since is None:
+            return out
+        inside, r, c = self._cells(points)
+        out[inside] = self.since[r, c].astype(np.int64) > self.scans - MIN_WALL_SCANS
+        return out
+
+    def at(self, points: NDArray[np.float64]) -> tuple[NDArray, NDArray, NDArray]:
+        """Per point (n, 2): the nearest wall point (n, 2), the wall's normal there (n, 2),
+        and the distance (n,) [m]; inf outside the window and where the nearest wall
+        point is where the memory's wall ends but the wall may go on (a return there may
+        lie beyond it, where the memory has not seen the wall yet)."""
+        inside, r, c = self._cells(points)
         d = np.full(len(points), np.inf)
         near = np.zeros((len(points), 2))
         normal = np.zeros((len(points), 2))
-        r, c = cells[inside, 1], cells[inside, 0]
         near[inside] = self.nearest[r, c]
         normal[inside] = self.normal[r, c]
         d[inside] = np.hypot(*(points[inside] - near[inside]).T)
+        if self.end is not None:
+            d[np.flatnonzero(inside)[self.end[r, c]]] = np.inf
         return near, normal, d
+
+
+def _ends(wall: NDArray[np.bool_], normal: NDArray[np.float64],
+          seen_free: NDArray[np.bool_]) -> NDArray[np.bool_]:
+    """The wall cells (h, w) where what the memory holds of a wall ends but the wall may
+    go on: no wall cell within one cell of the point END_PROBE cells along the wall
+    (across its normal) on one side or the other, and that point not ``seen_free``
+    (unknown: not yet seen, behind someone, beyond the laser's range; or a wall too new
+    to trust). Where the memory has seen free space beyond (a door's jamb, a corner), the
+    end is a real one and stays: it is what fixes the pose along a corridor. Out of the
+    mask counts as wall."""
+    h, w = wall.shape
+    near_wall = ndimage.binary_dilation(wall, np.ones((3, 3), bool))
+    rows, cols = np.nonzero(wall)
+    t = normal[rows, cols][:, ::-1] * np.array([1.0, -1.0])   # (x, y) along: (ny, -nx)
+    end = np.zeros_like(wall)
+    for sign in (1.0, -1.0):
+        c = np.rint(cols + sign * END_PROBE * t[:, 0]).astype(np.int64)
+        r = np.rint(rows + sign * END_PROBE * t[:, 1]).astype(np.int64)
+        inside = (r >= 0) & (c >= 0) & (r < h) & (c < w)
+        ri, ci = r[inside], c[inside]
+        open_end = ~near_wall[ri, ci] & ~seen_free[ri, ci]
+        end[rows[inside][open_end], cols[inside][open_end]] = True
+    return end
 
 
 def _normals(wall: NDArray[np.bool_]) -> NDArray[np.float64]:
@@ -115,12 +192,16 @@ def _normals(wall: NDArray[np.bool_]) -> NDArray[np.float64]:
 
 def distance_field(log_odds: NDArray[np.float32], origin: NDArray[np.float64],
                    resolution: float, around: NDArray[np.float64], reach: float,
-                   hit_offset: NDArray[np.float32] | None = None) -> DistanceField | None:
+                   hit_offset: NDArray[np.float32] | None = None,
+                   established_at: NDArray[np.int32] | None = None,
+                   scans: int = 0) -> DistanceField | None:
     """The field of the established cells of a log-odds grid (corner of cell (0, 0) at
     ``origin``) within ``reach`` [m] of the box of the points ``around`` (n, 2); None
     when that window holds no established cell. ``hit_offset`` (the grid's, h x w x 2
     [m]) places each wall point where the returns fell in its cell: matching to cell
-    centres would pull the pose by up to half a cell."""
+    centres would pull the pose by up to half a cell. ``established_at`` (the grid's,
+    h x w: the scan from which each cell has been established) and ``scans`` (the
+    grid's count now) tell how long each wall has stood (DistanceField.young)."""
     lo_xy = around.min(axis=0) - reach
     hi_xy = around.max(axis=0) + reach
     n_rows, n_cols = log_odds.shape
@@ -137,9 +218,12 @@ def distance_field(log_odds: NDArray[np.float32], origin: NDArray[np.float64],
     nearest = corner + (np.stack((cols, rows), axis=-1) + 0.5) * resolution
     if hit_offset is not None:   # where the returns fell in the cell, not its centre
         nearest = nearest + hit_offset[r0:r1, c0:c1][rows, cols]
-    normal = _normals(wall)[rows, cols]
-    return DistanceField((dist * resolution).astype(np.float32), nearest, normal, corner,
-                         resolution)
+    normals = _normals(wall)
+    since = None if established_at is None else established_at[r0:r1, c0:c1][rows, cols]
+    return DistanceField((dist * resolution).astype(np.float32), nearest,
+                         normals[rows, cols], corner, resolution,
+                         _ends(wall, normals, log_odds[r0:r1, c0:c1] < 0.0)[rows, cols],
+                         since, scans)
 
 
 def within_drift(predicted: NDArray[np.float64], matched: NDArray[np.float64],
@@ -172,21 +256,65 @@ class Match:
     rms: float
 
 
+def _beside(points: NDArray[np.float64], near: NDArray[np.float64],
+            normal: NDArray[np.float64], d: NDArray[np.float64],
+            resolution: float) -> NDArray[np.bool_]:
+    """Which returns take part: those within MAX_CORRESPONDENCE of a wall and beside it,
+    no more than ALONG_WALL cells from their nearest wall point along the wall. A return
+    beyond the end of a wall the memory holds (the part ahead not yet established) has
+    the wall's end as its nearest point; its residual there would pull the pose back
+    along the wall (a corridor's far end, a room's new wall)."""
+    off = points - near
+    along = np.abs(off[:, 0] * normal[:, 1] - off[:, 1] * normal[:, 0])
+    return (d <= MAX_CORRESPONDENCE) & (along <= ALONG_WALL * resolution)
+
+
+def _extents(points: NDArray[np.float64], pieces: NDArray[np.int64]) -> NDArray[np.float64]:
+    """The extent (bounding-box diagonal [m]) of each piece, by label (max label + 1,)."""
+    k = int(pieces.max()) + 1 if len(pieces) else 0
+    lo = np.full((k, 2), np.inf)
+    hi = np.full((k, 2), -np.inf)
+    np.minimum.at(lo, pieces, points)
+    np.maximum.at(hi, pieces, points)
+    return np.hypot(*(hi - lo).T)
+
+
+def landmarks(points: NDArray[np.float64], pieces: NDArray[np.int64],
+              mover_size: float) -> int:
+    """How many landmarks matched ``points`` (m, 2) [m] of the scan's pieces (their
+    cluster labels, m) make: each piece with MIN_PIECE_MATCHED of them counts one, and one
+    whose matched points span more than ``mover_size`` [m] (no mover is that long: a
+    wall) counts MIN_PIECES."""
+    labels, counts = np.unique(pieces, return_counts=True)
+    total = 0
+    for label in labels[counts >= MIN_PIECE_MATCHED]:
+        p = points[pieces == label]
+        total += MIN_PIECES if np.hypot(*np.ptp(p, axis=0)) > mover_size else 1
+    return total
+
+
 def align(base_points: NDArray[np.float64], predicted: NDArray[np.float64],
-          field: DistanceField | None) -> Match:
+          field: DistanceField | None, pieces: NDArray[np.int64] | None = None,
+          mover_size: float = math.inf) -> Match:
     """The pose of base_footprint that puts ``base_points`` (n, 2; the returns in
     base_footprint [m]) on the field's walls, starting from and drawn towards
-    ``predicted`` (x, y, yaw); see the module docstring."""
+    ``predicted`` (x, y, yaw); see the module docstring. With ``pieces`` (each point's
+    cluster label, n), a match is accepted only when its matched returns make MIN_PIECES
+    landmarks (:func:`landmarks`; ``mover_size`` [m] the longest a mover can be), and
+    the returns of pieces no longer than that match only walls that have stood
+    MIN_WALL_SCANS (DistanceField.young)."""
     prior = np.asarray(predicted, float).copy()
     if field is None or len(base_points) < MIN_MATCHED:
         return Match(prior, False, 0, math.nan)
+    small = np.zeros(len(base_points), bool) if pieces is None else \
+        _extents(base_points, pieces)[pieces] <= mover_size
     pose = prior.copy()
     info_prior = np.diag([PRIOR_SIGMA_XY ** -2, PRIOR_SIGMA_XY ** -2, PRIOR_SIGMA_YAW ** -2])
     w_ret = RETURN_SIGMA ** -2
     for _ in range(ITERATIONS):
         world = to_parent(pose, base_points)
         near, normal, d = field.at(world)
-        use = d <= MAX_CORRESPONDENCE
+        use = _beside(world, near, normal, d, field.resolution) & ~(small & field.young(world))
         if np.count_nonzero(use) < MIN_MATCHED:
             return Match(prior, False, int(np.count_nonzero(use)), math.nan)
         c, s = math.cos(pose[2]), math.sin(pose[2])
@@ -205,10 +333,13 @@ def align(base_points: NDArray[np.float64], predicted: NDArray[np.float64],
             break
     off = pose - prior
     off[2] = math.remainder(off[2], 2 * math.pi)
-    near, normal, d = field.at(to_parent(pose, base_points))
-    use = d <= MAX_CORRESPONDENCE
+    world = to_parent(pose, base_points)
+    near, normal, d = field.at(world)
+    use = _beside(world, near, normal, d, field.resolution) & ~(small & field.young(world))
     matched = int(np.count_nonzero(use))
     shift = float(np.hypot(off[0], off[1]))
     ok = matched >= MIN_MATCHED and shift <= MAX_STEP_XY and abs(off[2]) <= MAX_STEP_YAW
+    if ok and pieces is not None:
+        ok = landmarks(base_points[use], pieces[use], mover_size) >= MIN_PIECES
     rms = float(np.sqrt(np.mean(d[use] ** 2))) if matched else math.nan
     return Match(pose if ok else prior, bool(ok), matched, rms)

@@ -118,7 +118,7 @@ class PlannerConfig:
                               "so eq. (13)'s repulsion bends the path but cannot turn it back "
                               'in a passage narrower than 2 d0)', '', 0.0, 100.0)
     map_size: float = param(20.0, 'Side of the square occupancy window that follows the '
-                            'robot (memory bound: (map_size/map_resolution)^2 * 4 bytes, 14 '
+                            'robot (memory bound: (map_size/map_resolution)^2 * 4 bytes, 18 '
                             'with scan_alignment)',
                             'm', 2.0, 200.0)
     map_resolution: float = param(0.05, 'Occupancy cell size', 'm', 0.01, 0.5)
@@ -141,13 +141,12 @@ class PlannerConfig:
                                'marched on a worker thread and used from the next cycle: '
                                'a tick never waits for it, but among people the map reaches '
                                'the field a cycle late (README, Performance)')
-    scan_alignment: bool = param(False, 'Match each scan to the memory before it is written '
+    scan_alignment: bool = param(True, 'Match each scan to the memory before it is written '
                                  '(core/alignment.py): drifting wheel odometry is corrected, '
                                  'and the memory, the field and the goal live in the '
-                                 'corrected frame (with the geodesic attraction). Off by '
-                                 'default: among people it can follow a walker not yet '
-                                 'known to move (README, Getting there in buildings). '
-                                 'Switching it starts an empty map')
+                                 'corrected frame (with the geodesic attraction; README, '
+                                 'Getting there in buildings). Switching it starts an empty '
+                                 'map')
     # --- moving obstacles (core/tracking.py, core/evasion.py) ------------------------
     track_moving: bool = param(True, 'Track moving obstacles from the scans (clusters, '
                                'constant-velocity Kalman filters): their points stay out of '

@@ -31,9 +31,10 @@ from numpy.typing import ArrayLike, NDArray
 from .alignment import DistanceField, Match, align, distance_field
 from .config import PlannerConfig
 from .navigation import NavigationField, compute_field
-from .occupancy import OccupancyGrid
+from .occupancy import NOT_ESTABLISHED, OccupancyGrid
 from .robot import compose, to_parent
 from .scan import Scan, scan_to_points
+from .tracking import clusters
 
 #: Goals closer than this are the same goal (the field's, the controller's) [m].
 SAME_GOAL = 1e-3
@@ -170,6 +171,7 @@ class NavigationMemory:
             d = np.hypot(*(here[:, None, :] - centres[None]).transpose(2, 0, 1))
             still = np.all(d > radii[None] + MOVING_MARGIN, axis=1)
             base, here = base[still], here[still]
+        pieces = clusters(base, self.cfg.cluster_gap)[0]
         if len(base) == 0:
             return align(base, pred, None)
         f = self._distance
@@ -180,10 +182,11 @@ class NavigationMemory:
         if stale:
             g = self.grid
             self._distance = distance_field(g.log_odds, g.origin, g.resolution, here,
-                                            DISTANCE_FIELD_MARGIN, g.hit_offset)
+                                            DISTANCE_FIELD_MARGIN, g.hit_offset,
+                                            g.established_at, g.scans)
             self._distance_age = 0
         self._distance_age += 1
-        return align(base, pred, self._distance)
+        return align(base, pred, self._distance, pieces, self.cfg.max_mover_size)
 
     def avoid(self, point: ArrayLike, radius: float, until: float) -> None:
         """Block the cells within ``radius`` [m] of ``point`` in the navigation field
@@ -223,6 +226,8 @@ class NavigationMemory:
         hit = lo[cells[:, 0], cells[:, 1]] > 0.0
         if np.any(hit):
             lo[cells[hit, 0], cells[hit, 1]] = 0.0
+            if self.grid.established_at is not None:
+                self.grid.established_at[cells[hit, 0], cells[hit, 1]] = NOT_ESTABLISHED
             self.grid.version += 1
 
     def log_odds_at(self, points: ArrayLike) -> NDArray[np.float32]:

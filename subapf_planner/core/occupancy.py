@@ -41,6 +41,11 @@ LOG_ODDS_MAX = 3.5
 EDGE_MARGIN = 3.0
 #: Returns over which a cell's mean return place is kept (OccupancyGrid.hit_offset).
 HIT_MEMORY = 20
+#: Log odds from which a cell is an established obstacle (three hits or more: what the
+#: memory is sure of; the scan alignment's walls, OccupancyGrid.established_at).
+ESTABLISHED = 2.0
+#: OccupancyGrid.established_at of a cell that is not established.
+NOT_ESTABLISHED = np.iinfo(np.int32).max
 
 
 def cell_index(points: ArrayLike, origin: ArrayLike, resolution: float) -> NDArray[np.int64]:
@@ -74,6 +79,14 @@ class OccupancyGrid:
             np.zeros((n, n, 2), np.float32) if hit_places else None
         self.hit_count: NDArray[np.int16] | None = \
             np.zeros((n, n), np.int16) if hit_places else None
+        #: With ``hit_places``: the scan (``scans`` then) from which each cell has been
+        #: established, until misses leave it no longer occupied (NOT_ESTABLISHED): how
+        #: long a wall has stood, which a person who walked slowly into the memory has
+        #: not (core/alignment.py).
+        self.established_at: NDArray[np.int32] | None = \
+            np.full((n, n), NOT_ESTABLISHED, np.int32) if hit_places else None
+        #: Scans integrated so far.
+        self.scans = 0
         self.origin = np.array([-0.5, -0.5]) * self.cells * self.resolution
         self.version = 0   # bumped whenever the occupied set (log odds > 0) changed
 
@@ -86,7 +99,7 @@ class OccupancyGrid:
     @property
     def nbytes(self) -> int:
         """Memory held by the grid [bytes]."""
-        layers = (self.log_odds, self.hit_offset, self.hit_count)
+        layers = (self.log_odds, self.hit_offset, self.hit_count, self.established_at)
         return int(sum(a.nbytes for a in layers if a is not None))
 
     def cell_of(self, points: ArrayLike) -> NDArray[np.int64]:
@@ -132,11 +145,12 @@ class OccupancyGrid:
         n = self.cells
         dx, dy = int(d[0]), int(d[1])
         layers = []
-        for a in (self.log_odds, self.hit_offset, self.hit_count):
+        for a in (self.log_odds, self.hit_offset, self.hit_count, self.established_at):
             if a is None:   # no hit places kept
                 layers.append(a)
                 continue
-            shifted = np.zeros_like(a)
+            shifted = np.full_like(a, NOT_ESTABLISHED) if a is self.established_at \
+                else np.zeros_like(a)
             if abs(dx) < n and abs(dy) < n:
                 src_r = slice(max(dy, 0), n + min(dy, 0))
                 dst_r = slice(max(-dy, 0), n + min(-dy, 0))
@@ -144,7 +158,7 @@ class OccupancyGrid:
                 dst_c = slice(max(-dx, 0), n + min(-dx, 0))
                 shifted[dst_r, dst_c] = a[src_r, src_c]
             layers.append(shifted)
-        self.log_odds, self.hit_offset, self.hit_count = layers
+        self.log_odds, self.hit_offset, self.hit_count, self.established_at = layers
         self.origin = new_origin
         self.version += 1
 
@@ -156,6 +170,7 @@ class OccupancyGrid:
         (Scan.check: the planner refuses a bad scan before this is called).
         ``transient`` (per beam): returns of something moving; their beams clear the
         cells they cross but their end cells are not marked (core/tracking.py)."""
+        self.scans += 1
         r = np.asarray(scan.ranges, float).ravel()
         lx, ly, lyaw = (float(v) for v in laser_pose)
         angles = scan.angles + lyaw
@@ -209,6 +224,11 @@ class OccupancyGrid:
             old + np.where(mark[touched] == 2, np.float32(HIT), np.float32(MISS)),
             np.float32(LOG_ODDS_MIN)), np.float32(LOG_ODDS_MAX))
         log_odds[cells] = new
+        if self.established_at is not None:
+            since = self.established_at.reshape(-1)   # a view, as log_odds
+            first = (new >= ESTABLISHED) & (since[cells] == NOT_ESTABLISHED)
+            since[cells[first]] = self.scans
+            since[cells[new <= 0.0]] = NOT_ESTABLISHED
         if np.any((old > 0.0) != (new > 0.0)):
             self.version += 1
 

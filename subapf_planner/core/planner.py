@@ -57,6 +57,10 @@ _EMPTY = np.zeros((0, 2))
 AVOID_AHEAD = 0.5
 #: ... a disc of this radius [m] (a door and its sides).
 AVOID_RADIUS = 0.35
+#: With the scan alignment, the robot stands until the memory holds this many scans: the
+#: first walls are established (three hits) from where it started, before any drift; for
+#: this many cycles at most (a scan repeated with the same stamp is not taken twice).
+FIRST_SCANS = 3
 #: Inside goal_tolerance, a cycle that brings the robot less than this closer to the goal
 #: ends the approach (it cannot get closer: arrival_distance) [m].
 ARRIVAL_PROGRESS = 0.002
@@ -238,6 +242,7 @@ class Planner:
         self._aligned_from: NDArray | None = None   # odom pose of the last scan matched
         self._goal: tuple[NDArray, NDArray] | None = None   # (in odom, in the memory's frame)
         self._planned_from: NDArray | None = None   # the last cycle's pose (memory's frame)
+        self._mapping_cycles = 0   # cycles stood for the first walls (FIRST_SCANS)
 
     def step(self, pose: ArrayLike, goal: ArrayLike, scan: Scan,
              scan_pose: ArrayLike | None = None, now: float | None = None,
@@ -274,6 +279,8 @@ class Planner:
             self.memory.integrate(scan, scan_pose, goal, transient)
         seen = _situation(pose, goal, points)
         status = goal_status(cfg, seen['goal_distance'], goal, seen['obstacles'])
+        if status is None and cfg.geodesic and cfg.scan_alignment and self._mapping():
+            status = Status.MAPPING
         if status is Status.REACHED and self._drives_on(goal, seen['goal_distance']):
             status = None
         self._approach = (goal, seen['goal_distance'])
@@ -300,6 +307,13 @@ class Planner:
             return self._stop(result)
         self.previous = (result.command.v, result.command.w)
         return result
+
+    def _mapping(self) -> bool:
+        """Whether this cycle stands for the first walls (FIRST_SCANS; counts the cycle)."""
+        if self.memory.grid.scans >= FIRST_SCANS or self._mapping_cycles >= FIRST_SCANS:
+            return False
+        self._mapping_cycles += 1
+        return True
 
     def _drives_on(self, goal: NDArray, distance: float) -> bool:
         """Inside goal_tolerance at ``distance`` [m] from ``goal``: whether to drive on

@@ -24,6 +24,10 @@ class Status(StrEnum):
     INVALID_SCAN = 'invalid_scan'
     INVALID_POSE = 'invalid_pose'
     INVALID_GOAL = 'invalid_goal'
+    #: The scan alignment's memory is new (fewer than planner.FIRST_SCANS scans): the
+    #: robot stands while the first walls are established, so that the memory's frame is
+    #: odom at the start, not odom turned by the drift of a first turn.
+    MAPPING = 'mapping'
 
     @property
     def stops(self) -> bool:
@@ -33,7 +37,7 @@ class Status(StrEnum):
 
 STOP_STATUSES = frozenset({Status.NO_SAFE_MOVE, Status.GOAL_IN_OBSTACLE,
                            Status.GOAL_UNREACHABLE, Status.INVALID_SCAN,
-                           Status.INVALID_POSE, Status.INVALID_GOAL})
+                           Status.INVALID_POSE, Status.INVALID_GOAL, Status.MAPPING})
 
 
 class State(StrEnum):

@@ -3,9 +3,10 @@ Kalman filters; which points move.
 
 Each scan's obstacle points (odom, in beam order) are cut into clusters where
 two neighbours are ``cluster_gap`` or more apart (laser scan segmentation); a
-cluster longer than ``max_mover_size``, straight (a piece of wall seen at a
-grazing angle), or standing mostly on the memory's established obstacles, is a
-wall and is never tracked. The others are
+cluster longer than ``max_mover_size`` (NEW_SIZE_FACTOR times that when it stands on
+cells the memory saw free), straight (a piece of wall seen at a grazing angle), or
+standing mostly on the memory's established obstacles, is a wall and is never
+tracked. The others are
 associated with the tracks predicted to this scan's time (Hungarian assignment,
 scipy, within ``track_gate``) and update their filter; unmatched clusters start
 tentative tracks, and a track unseen for MAX_MISSES scans is dropped.
@@ -35,6 +36,8 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import NDArray
 from scipy.optimize import linear_sum_assignment
+
+from .occupancy import ESTABLISHED
 
 #: Process noise density of the constant-velocity model [m^2/s^3].
 ACCEL_NOISE = 0.5
@@ -76,8 +79,12 @@ TRAIL_SCANS = 12
 FREE_LOG_ODDS = -0.5
 #: Fraction of a cluster's points on seen-free cells that makes it new.
 NEW_FRACTION = 0.5
+#: A cluster up to this many times max_mover_size is still tracked when it is new
+#: (NEW_FRACTION of it on seen-free cells): a wall does not stand where the memory saw
+#: free space, people walking together do.
+NEW_SIZE_FACTOR = 2.0
 #: Log odds from which a cell is an established obstacle (three hits or more) ...
-WALL_LOG_ODDS = 2.0
+WALL_LOG_ODDS = ESTABLISHED
 #: ... and the fraction of a cluster's points on such cells that makes it part of the
 #: map: a piece of wall whose visible part changes as the robot drives, not a mover.
 WALL_FRACTION = 0.5
@@ -217,8 +224,12 @@ class Tracker:
             self._predict(dt)
         labels, count = clusters(points, self.gap)
         cents, sizes, new, mapped, thin = _cluster_features(points, labels, count, log_odds_at)
-        # walls (long, or standing on the map's established obstacles) are not tracked
-        small = np.flatnonzero((sizes <= self.max_size) & (mapped < WALL_FRACTION) & ~thin)
+        # walls are not tracked: long clusters (but up to NEW_SIZE_FACTOR times as long
+        # where the memory saw free space: people side by side, or one close enough to
+        # show their whole width), straight ones, those on the map's established obstacles
+        fits = (sizes <= self.max_size) | ((new >= NEW_FRACTION)
+                                           & (sizes <= NEW_SIZE_FACTOR * self.max_size))
+        small = np.flatnonzero(fits & (mapped < WALL_FRACTION) & ~thin)
         small = small[np.argsort(-sizes[small], kind='stable')][:MAX_CLUSTERS]
         track_of = np.full(count, -1, np.int64)
         n_tracks = len(self.x)
