@@ -246,8 +246,8 @@ def test_one_mover_sized_thing_is_no_landmark_two_or_a_wall_are():
                             (np.vstack([disc((0.5, 0.2)), disc((-0.4, -0.5))]), True),
                             (segment((-1.5, 0.925), (1.5, 0.925)), True)):
         base = seen_from(walls, true, noise=0.0)
-        field = distance_field(grid_with(walls).log_odds, grid_with(walls).origin, RES,
-                               to_parent(off, base), 0.4)
+        g = grid_with(walls)
+        field = distance_field(g.log_odds, g.origin, RES, to_parent(off, base), 0.4)
         m = align(base, off, field, clusters(base, 0.15)[0], 1.2)
         assert m.matched >= MIN_MATCHED
         assert m.accepted is accepted

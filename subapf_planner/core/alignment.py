@@ -286,11 +286,18 @@ def landmarks(points: NDArray[np.float64], pieces: NDArray[np.int64],
     whose matched points span more than ``mover_size`` [m] (no mover is that long: a
     wall) counts MIN_PIECES."""
     labels, counts = np.unique(pieces, return_counts=True)
-    total = 0
-    for label in labels[counts >= MIN_PIECE_MATCHED]:
-        p = points[pieces == label]
-        total += MIN_PIECES if np.hypot(*np.ptp(p, axis=0)) > mover_size else 1
-    return total
+    span = _extents(points, pieces)[labels[counts >= MIN_PIECE_MATCHED]]
+    return int(np.sum(np.where(span > mover_size, MIN_PIECES, 1)))
+
+
+def _taking_part(field: DistanceField, world: NDArray[np.float64],
+                 small: NDArray[np.bool_]) -> tuple[NDArray, NDArray, NDArray, NDArray]:
+    """For the returns at ``world`` (n, 2) [m]: the nearest wall point, the normal, the
+    distance (DistanceField.at) and which take part: beside a wall (:func:`_beside`), and
+    for those of ``small`` pieces, a wall that has stood (DistanceField.young)."""
+    near, normal, d = field.at(world)
+    use = _beside(world, near, normal, d, field.resolution) & ~(small & field.young(world))
+    return near, normal, d, use
 
 
 def align(base_points: NDArray[np.float64], predicted: NDArray[np.float64],
@@ -313,8 +320,7 @@ def align(base_points: NDArray[np.float64], predicted: NDArray[np.float64],
     w_ret = RETURN_SIGMA ** -2
     for _ in range(ITERATIONS):
         world = to_parent(pose, base_points)
-        near, normal, d = field.at(world)
-        use = _beside(world, near, normal, d, field.resolution) & ~(small & field.young(world))
+        near, normal, d, use = _taking_part(field, world, small)
         if np.count_nonzero(use) < MIN_MATCHED:
             return Match(prior, False, int(np.count_nonzero(use)), math.nan)
         c, s = math.cos(pose[2]), math.sin(pose[2])
@@ -333,9 +339,7 @@ def align(base_points: NDArray[np.float64], predicted: NDArray[np.float64],
             break
     off = pose - prior
     off[2] = math.remainder(off[2], 2 * math.pi)
-    world = to_parent(pose, base_points)
-    near, normal, d = field.at(world)
-    use = _beside(world, near, normal, d, field.resolution) & ~(small & field.young(world))
+    _, _, d, use = _taking_part(field, to_parent(pose, base_points), small)
     matched = int(np.count_nonzero(use))
     shift = float(np.hypot(off[0], off[1]))
     ok = matched >= MIN_MATCHED and shift <= MAX_STEP_XY and abs(off[2]) <= MAX_STEP_YAW

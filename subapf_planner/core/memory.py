@@ -31,7 +31,7 @@ from numpy.typing import ArrayLike, NDArray
 from .alignment import DistanceField, Match, align, distance_field
 from .config import PlannerConfig
 from .navigation import NavigationField, compute_field
-from .occupancy import NOT_ESTABLISHED, OccupancyGrid
+from .occupancy import OccupancyGrid
 from .robot import compose, to_parent
 from .scan import Scan, scan_to_points
 from .tracking import clusters
@@ -221,14 +221,7 @@ class NavigationMemory:
         """Cells under ``points`` (n, 2) [m] that are occupied become unknown: something
         that moved stood there (core/tracking.py's trail)."""
         cells = self.grid.cell_of(np.asarray(points, float).reshape(-1, 2))
-        cells = cells[self.grid.inside(cells)]
-        lo = self.grid.log_odds
-        hit = lo[cells[:, 0], cells[:, 1]] > 0.0
-        if np.any(hit):
-            lo[cells[hit, 0], cells[hit, 1]] = 0.0
-            if self.grid.established_at is not None:
-                self.grid.established_at[cells[hit, 0], cells[hit, 1]] = NOT_ESTABLISHED
-            self.grid.version += 1
+        self.grid.clear(cells[self.grid.inside(cells)])
 
     def log_odds_at(self, points: ArrayLike) -> NDArray[np.float32]:
         """The map's log odds at each point (n, 2) [m] (0, unknown, off the window)."""

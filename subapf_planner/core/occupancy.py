@@ -114,6 +114,16 @@ class OccupancyGrid:
     def inside(self, cells: NDArray[np.int64]) -> NDArray[np.bool_]:
         return np.all((cells >= 0) & (cells < self.cells), axis=1)
 
+    def clear(self, cells: NDArray[np.int64]) -> None:
+        """Cells (n, 2; row, col, inside the window) that are occupied become unknown (and
+        no longer established): something that moved stood there."""
+        hit = self.log_odds[cells[:, 0], cells[:, 1]] > 0.0
+        if np.any(hit):
+            self.log_odds[cells[hit, 0], cells[hit, 1]] = 0.0
+            if self.established_at is not None:
+                self.established_at[cells[hit, 0], cells[hit, 1]] = NOT_ESTABLISHED
+            self.version += 1
+
     def occupied(self) -> NDArray[np.bool_]:
         """Occupied cells (log odds > 0), a new array."""
         return self.log_odds > 0.0
