@@ -308,8 +308,9 @@ def test_a_walls_end_is_found_and_returns_beyond_it_do_not_pull():
     wall[2, 3:15] = True
     normal = np.zeros((5, 20, 2))
     normal[..., 1] = 1.0
-    ends = np.argwhere(_ends(wall, normal, np.zeros_like(wall)))          # unknown beyond
-    assert not _ends(wall, normal, ~wall).any()              # seen free beyond: a jamb
+    cells = np.argwhere(wall)
+    ends = cells[_ends(wall, normal[wall], np.zeros_like(wall))]          # unknown beyond
+    assert not _ends(wall, normal[wall], ~wall).any()        # seen free beyond: a jamb
     assert sorted(map(tuple, ends)) == [(2, 3), (2, 14)]
     known = np.vstack([segment((-1.525, -0.625), (1.0, -0.625)),
                        segment((-1.525, 0.625), (1.0, 0.625)),

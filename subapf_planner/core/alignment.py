@@ -103,88 +103,104 @@ DRIFT_YAW_PER_RAD = 0.05
 @dataclass(frozen=True)
 class DistanceField:
     """For the cells of a window (rows = y; cell (0, 0) with its corner at ``origin``
-    [m]): the nearest established obstacle cell's centre (h, w, 2) [m] and the wall's
-    unit normal there (h, w, 2), and the distance to it (h, w) [m]."""
+    [m]; ``shape`` (h, w)): which established obstacle cell is the nearest (``wall``,
+    (h, w): its index in the wall-cell tables), and per wall cell (k of them) the wall
+    point (k, 2) [m] and the wall's unit normal there (k, 2). The tables are per wall
+    cell, not per window cell: a field is made every few scans and read at a few hundred
+    returns, so what a return needs is looked up when it is asked for."""
 
-    values: NDArray[np.float32]
-    nearest: NDArray[np.float64]
+    wall: NDArray[np.int32]
+    point: NDArray[np.float64]
     normal: NDArray[np.float64]
     origin: NDArray[np.float64]
     resolution: float
-    #: Per cell (h, w): its nearest wall cell is where the memory's wall ends but the wall
-    #: may go on (:func:`_ends`).
+    #: Per wall cell (k,): where the memory's wall ends but the wall may go on
+    #: (:func:`_ends`).
     end: NDArray[np.bool_] | None = None
-    #: Per cell (h, w): the scan from which its nearest wall cell has been established
-    #: (OccupancyGrid.established_at), and the grid's scan count when the field was made.
-    since: NDArray[np.int32] | None = None
-    scans: int = 0
+    #: Per wall cell (k,): established fewer than MIN_WALL_SCANS scans before the field
+    #: was made (OccupancyGrid.established_at).
+    new: NDArray[np.bool_] | None = None
 
-    def _cells(self, points: NDArray[np.float64]) -> tuple[NDArray, NDArray, NDArray]:
-        """Which points (n, 2) lie in the window (n,), and the row and column of those."""
+    @property
+    def shape(self) -> tuple[int, int]:
+        """The window's (rows, columns)."""
+        return self.wall.shape
+
+    def _walls(self, points: NDArray[np.float64]) -> tuple[NDArray, NDArray]:
+        """Which points (n, 2) lie in the window (n,), and the nearest wall cell of each
+        of those (its index in the tables)."""
         cells = np.floor((points - self.origin) / self.resolution).astype(np.int64)
-        h, w = self.values.shape
+        h, w = self.wall.shape
         inside = (cells[:, 0] >= 0) & (cells[:, 1] >= 0) & (cells[:, 0] < w) \
             & (cells[:, 1] < h)
-        return inside, cells[inside, 1], cells[inside, 0]
+        return inside, self.wall[cells[inside, 1], cells[inside, 0]]
+
+    def lookup(self, points: NDArray[np.float64]
+               ) -> tuple[NDArray, NDArray, NDArray, NDArray]:
+        """Per point (n, 2): the nearest wall point (n, 2), the wall's normal there (n, 2),
+        the distance (n,) [m], inf outside the window and where the nearest wall point is
+        where the memory's wall ends but the wall may go on (a return there may lie
+        beyond it, where the memory has not seen the wall yet), and whether that wall
+        cell has been established for fewer than MIN_WALL_SCANS scans (n,) (False
+        outside the window or without the grid's ``established_at``)."""
+        inside, k = self._walls(points)
+        n = len(points)
+        d = np.full(n, np.inf)
+        near = np.zeros((n, 2))
+        normal = np.zeros((n, 2))
+        young = np.zeros(n, bool)
+        near[inside] = self.point[k]
+        normal[inside] = self.normal[k]
+        d[inside] = np.hypot(*(points[inside] - near[inside]).T)
+        if self.end is not None:
+            d[np.flatnonzero(inside)[self.end[k]]] = np.inf
+        if self.new is not None:
+            young[inside] = self.new[k]
+        return near, normal, d, young
+
+    def at(self, points: NDArray[np.float64]) -> tuple[NDArray, NDArray, NDArray]:
+        """Per point (n, 2): the nearest wall point, the normal, the distance
+        (:meth:`lookup`)."""
+        return self.lookup(points)[:3]
 
     def young(self, points: NDArray[np.float64]) -> NDArray[np.bool_]:
         """Per point (n, 2): its nearest wall cell has been established for fewer than
-        MIN_WALL_SCANS scans (False outside the window or without ``since``)."""
-        out = np.zeros(len(points), bool)
-        if self.since is None:
-            return out
-        inside, r, c = self._cells(points)
-        out[inside] = self.since[r, c].astype(np.int64) > self.scans - MIN_WALL_SCANS
-        return out
-
-    def at(self, points: NDArray[np.float64]) -> tuple[NDArray, NDArray, NDArray]:
-        """Per point (n, 2): the nearest wall point (n, 2), the wall's normal there (n, 2),
-        and the distance (n,) [m]; inf outside the window and where the nearest wall
-        point is where the memory's wall ends but the wall may go on (a return there may
-        lie beyond it, where the memory has not seen the wall yet)."""
-        inside, r, c = self._cells(points)
-        d = np.full(len(points), np.inf)
-        near = np.zeros((len(points), 2))
-        normal = np.zeros((len(points), 2))
-        near[inside] = self.nearest[r, c]
-        normal[inside] = self.normal[r, c]
-        d[inside] = np.hypot(*(points[inside] - near[inside]).T)
-        if self.end is not None:
-            d[np.flatnonzero(inside)[self.end[r, c]]] = np.inf
-        return near, normal, d
+        MIN_WALL_SCANS scans (:meth:`lookup`)."""
+        return self.lookup(points)[3]
 
 
 def _ends(wall: NDArray[np.bool_], normal: NDArray[np.float64],
           seen_free: NDArray[np.bool_]) -> NDArray[np.bool_]:
-    """The wall cells (h, w) where what the memory holds of a wall ends but the wall may
-    go on: no wall cell within one cell of the point END_PROBE cells along the wall
-    (across its normal) on one side or the other, and that point not ``seen_free``
-    (unknown: not yet seen, behind someone, beyond the laser's range; or a wall too new
-    to trust). Where the memory has seen free space beyond (a door's jamb, a corner), the
-    end is a real one and stays: it is what fixes the pose along a corridor. Out of the
-    mask counts as wall."""
+    """Which wall cells (those of ``np.nonzero(wall)``, with their unit ``normal`` (k, 2))
+    are where what the memory holds of a wall ends but the wall may go on (k,): no wall
+    cell within one cell of the point END_PROBE cells along the wall (across its normal)
+    on one side or the other, and that point not ``seen_free`` (unknown: not yet seen,
+    behind someone, beyond the laser's range; or a wall too new to trust). Where the
+    memory has seen free space beyond (a door's jamb, a corner), the end is a real one
+    and stays: it is what fixes the pose along a corridor. Out of the mask counts as
+    wall."""
     h, w = wall.shape
     near_wall = ndimage.binary_dilation(wall, np.ones((3, 3), bool))
     rows, cols = np.nonzero(wall)
-    t = normal[rows, cols][:, ::-1] * np.array([1.0, -1.0])   # (x, y) along: (ny, -nx)
-    end = np.zeros_like(wall)
+    t = normal[:, ::-1] * np.array([1.0, -1.0])   # (x, y) along: (ny, -nx)
+    end = np.zeros(rows.size, bool)
     for sign in (1.0, -1.0):
         c = np.rint(cols + sign * END_PROBE * t[:, 0]).astype(np.int64)
         r = np.rint(rows + sign * END_PROBE * t[:, 1]).astype(np.int64)
         inside = (r >= 0) & (c >= 0) & (r < h) & (c < w)
         ri, ci = r[inside], c[inside]
         open_end = ~near_wall[ri, ci] & ~seen_free[ri, ci]
-        end[rows[inside][open_end], cols[inside][open_end]] = True
+        end[np.flatnonzero(inside)[open_end]] = True
     return end
 
 
 def _normals(wall: NDArray[np.bool_]) -> NDArray[np.float64]:
-    """Unit normal (h, w, 2) of the walls of a mask at each cell: the principal direction
-    of the structure tensor of the blurred mask (across a line of cells; any at a
-    lone cell)."""
+    """Unit normal (k, 2) of the walls of a mask at its wall cells (``np.nonzero(wall)``):
+    the principal direction of the structure tensor of the blurred mask (across a line
+    of cells; any at a lone cell)."""
     blurred = ndimage.gaussian_filter(wall.astype(np.float32), NORMAL_SIGMA)
     gy, gx = ndimage.sobel(blurred, axis=0), ndimage.sobel(blurred, axis=1)
-    sxx, syy, sxy = (ndimage.gaussian_filter(v, NORMAL_SIGMA)
+    sxx, syy, sxy = (ndimage.gaussian_filter(v, NORMAL_SIGMA)[wall]
                      for v in (gx * gx, gy * gy, gx * gy))
     angle = 0.5 * np.arctan2(2.0 * sxy, sxx - syy)   # of the larger eigenvalue
     return np.stack((np.cos(angle), np.sin(angle)), axis=-1).astype(np.float64)
@@ -201,7 +217,7 @@ def distance_field(log_odds: NDArray[np.float32], origin: NDArray[np.float64],
     [m]) places each wall point where the returns fell in its cell: matching to cell
     centres would pull the pose by up to half a cell. ``established_at`` (the grid's,
     h x w: the scan from which each cell has been established) and ``scans`` (the
-    grid's count now) tell how long each wall has stood (DistanceField.young)."""
+    grid's count now) tell how long each wall has stood (DistanceField.lookup)."""
     lo_xy = around.min(axis=0) - reach
     hi_xy = around.max(axis=0) + reach
     n_rows, n_cols = log_odds.shape
@@ -213,17 +229,21 @@ def distance_field(log_odds: NDArray[np.float32], origin: NDArray[np.float64],
     wall = log_odds[r0:r1, c0:c1] >= ESTABLISHED
     if not np.any(wall):
         return None
-    dist, (rows, cols) = ndimage.distance_transform_edt(~wall, return_indices=True)
+    rows, cols = ndimage.distance_transform_edt(~wall, return_distances=False,
+                                                return_indices=True)
+    wall_rows, wall_cols = np.nonzero(wall)
+    index = np.zeros(wall.shape, np.int32)
+    index[wall_rows, wall_cols] = np.arange(wall_rows.size, dtype=np.int32)
     corner = origin + np.array([c0, r0]) * resolution
-    nearest = corner + (np.stack((cols, rows), axis=-1) + 0.5) * resolution
+    point = corner + (np.stack((wall_cols, wall_rows), axis=-1) + 0.5) * resolution
     if hit_offset is not None:   # where the returns fell in the cell, not its centre
-        nearest = nearest + hit_offset[r0:r1, c0:c1][rows, cols]
+        point = point + hit_offset[r0:r1, c0:c1][wall_rows, wall_cols]
     normals = _normals(wall)
-    since = None if established_at is None else established_at[r0:r1, c0:c1][rows, cols]
-    return DistanceField((dist * resolution).astype(np.float32), nearest,
-                         normals[rows, cols], corner, resolution,
-                         _ends(wall, normals, log_odds[r0:r1, c0:c1] < 0.0)[rows, cols],
-                         since, scans)
+    new = None if established_at is None else \
+        established_at[r0:r1, c0:c1][wall_rows, wall_cols].astype(np.int64) \
+        > scans - MIN_WALL_SCANS
+    return DistanceField(index[rows, cols], point, normals, corner, resolution,
+                         _ends(wall, normals, log_odds[r0:r1, c0:c1] < 0.0), new)
 
 
 def within_drift(predicted: NDArray[np.float64], matched: NDArray[np.float64],
@@ -295,8 +315,8 @@ def _taking_part(field: DistanceField, world: NDArray[np.float64],
     """For the returns at ``world`` (n, 2) [m]: the nearest wall point, the normal, the
     distance (DistanceField.at) and which take part: beside a wall (:func:`_beside`), and
     for those of ``small`` pieces, a wall that has stood (DistanceField.young)."""
-    near, normal, d = field.at(world)
-    use = _beside(world, near, normal, d, field.resolution) & ~(small & field.young(world))
+    near, normal, d, young = field.lookup(world)
+    use = _beside(world, near, normal, d, field.resolution) & ~(small & young)
     return near, normal, d, use
 
 

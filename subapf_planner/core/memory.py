@@ -176,7 +176,7 @@ class NavigationMemory:
             return align(base, pred, None)
         f = self._distance
         reach = np.array([0.0, 0.0]) if f is None else f.origin + np.array(
-            f.values.shape[::-1]) * f.resolution
+            f.shape[::-1]) * f.resolution
         stale = f is None or self._distance_age >= DISTANCE_FIELD_SCANS or np.any(
             here.min(axis=0) < f.origin) or np.any(here.max(axis=0) > reach)
         if stale:
