@@ -360,3 +360,49 @@ def test_a_static_chain_sets_the_laser_mounting_unless_a_link_of_it_is_tilted(ha
     h.node._on_tf_static(SimpleNamespace(transforms=[
         transform_msg('base_footprint', 'base_link', (0.0, 0.0, 0.01), 0.0, 0.0), scan]))
     assert h.node.ctl.cfg.laser_mount == pytest.approx((0.5, 0.1, 0.0))
+
+
+def test_spin_node_waits_without_polling_and_a_signal_wakes_it():
+    """ros/spinning.py: the spin loop waits for its node's timers and messages alone (no
+    STOP_POLL wake-ups: a node with nothing to do spins once in 1.5 s), and a SIGINT
+    then wakes it: on_shutdown runs within a second of the signal."""
+    import os
+    import signal
+    import threading
+    import time
+
+    from rclpy.node import Node
+
+    from subapf_planner.ros import spinning
+
+    handlers = {s: signal.getsignal(s) for s in (signal.SIGINT, signal.SIGTERM)}
+    spins = []
+
+    class Idle(Node):
+        def __init__(self) -> None:
+            super().__init__('idle')
+
+    original = spinning.SingleThreadedExecutor.spin_once
+
+    def counted(self, timeout_sec=None):
+        spins.append(timeout_sec)
+        return original(self, timeout_sec)
+    sent = []
+
+    def interrupt() -> None:
+        sent.append(time.monotonic())
+        os.kill(os.getpid(), signal.SIGINT)
+    timer = threading.Timer(1.5, interrupt)
+    shut = []
+    try:
+        spinning.SingleThreadedExecutor.spin_once = counted
+        timer.start()
+        assert spinning.spin_node(Idle, 'subapf-test', (ValueError,),
+                                  lambda n: shut.append(time.monotonic()), []) == 0
+    finally:
+        timer.cancel()
+        spinning.SingleThreadedExecutor.spin_once = original
+        for s, h in handlers.items():
+            signal.signal(s, h)
+    assert sent and shut and shut[0] - sent[0] < 1.0
+    assert spins and set(spins) == {None} and len(spins) <= 2

@@ -138,3 +138,26 @@ def test_perfect_odometry_starts_at_the_start_and_then_is_the_true_pose():
         sim.step(0.4)
         np.testing.assert_array_equal(sim.odometry()[0], sim.true_pose())
         assert sim.odometry()[0][0] > 1.05
+
+
+def test_scan_threads_change_the_speed_not_the_ranges():
+    """rayTestBatch on one thread (subapf-bench's workers) and on all cores (the default)
+    casts the same beams: a forest of cylinders and boxes seen from 12 places, equal to
+    the bit, with at least 100 returns each."""
+    rng = np.random.default_rng(3)
+    obstacles = [{'circle': {'center': [float(x), float(y)], 'radius': 0.2}}
+                 for x, y in rng.uniform(-3.0, 3.0, (25, 2)) if math.hypot(x, y) > 0.6]
+    obstacles += [{'box': {'center': [0.0, 3.2], 'size': [6.0, 0.2], 'yaw': 0.3}}]
+    sims = [BurgerSim(world(obstacles), SimConfig(scan_threads=n, range_noise=0.0))
+            for n in (1, 0)]
+    try:
+        for _ in range(12):
+            for s in sims:
+                s.set_command(0.2, 1.0)
+                s.step(0.5)
+            one, every = (s.scan().ranges for s in sims)
+            assert np.count_nonzero(np.isfinite(one)) >= 100
+            np.testing.assert_array_equal(one, every)
+    finally:
+        for s in sims:
+            s.close()

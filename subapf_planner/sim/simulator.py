@@ -65,6 +65,10 @@ class SimConfig:
                                    'step (its default, 50; fewer is faster and the wheels '
                                    'slip differently: README, Performance)', '', 1, 500,
                                    read_only=True)
+    scan_threads: int = param(0, "Threads PyBullet's rayTestBatch casts a sweep's beams on "
+                              '(0: all cores; the ranges are the same for any number: '
+                              'subapf-bench, one process per core, uses 1)', '', 0, 64,
+                              read_only=True)
     scan_beams: int = param(360, 'Lidar beams per sweep (LDS-01: 360)', '', 1, 4096,
                             read_only=True)
     range_min: float = param(0.12, 'Lidar minimum range', 'm', 0.0, 1.0, read_only=True)
@@ -308,7 +312,8 @@ class BurgerSim:
         n = a.size
         origin = np.tile([ox, oy, ROBOT.laser.z], (n, 1))
         ends = origin + cfg.range_max * np.column_stack((np.cos(a), np.sin(a), np.zeros(n)))
-        hits = pybullet.rayTestBatch(origin.tolist(), ends.tolist(), physicsClientId=self._cid)
+        hits = pybullet.rayTestBatch(origin.tolist(), ends.tolist(),
+                                     numThreads=cfg.scan_threads, physicsClientId=self._cid)
         frac = np.array([h[2] if h[0] >= 0 else np.inf for h in hits])
         ranges = frac * cfg.range_max
         if cfg.range_noise > 0.0:

@@ -238,7 +238,8 @@ def main(argv: list[str] | None = None) -> int:
         sim_cfg = SimConfig(seed=args.seed, range_noise=args.noise,
                             beam_dropout=args.beam_dropout,
                             odom_distance_scale=args.odom_scale,
-                            odom_yaw_scale=args.odom_yaw_scale)
+                            odom_yaw_scale=args.odom_yaw_scale,
+                            scan_threads=1)   # one process per core already
         faults = ScanFaults(args.scan_dropout, args.scan_latency)
         files = world_files(args.worlds or [shipped_worlds_dir()])
         worlds = {str(f): load_world(f) for f in files}
