@@ -105,35 +105,26 @@ class DistanceField:
     """For the cells of a window (rows = y; cell (0, 0) with its corner at ``origin``
     [m]; ``shape`` (h, w)): which established obstacle cell is the nearest (``wall``,
     (h, w): its index in the wall-cell tables), and per wall cell (k of them) the wall
-    point (k, 2) [m] and the wall's unit normal there (k, 2). The tables are per wall
-    cell, not per window cell: a field is made every few scans and read at a few hundred
-    returns, so what a return needs is looked up when it is asked for."""
+    point (k, 2) [m], the wall's unit normal there (k, 2), whether the memory's wall
+    ends there but the wall may go on (``end``, k: :func:`_ends`) and whether it was
+    established fewer than MIN_WALL_SCANS scans before the field was made (``new``, k:
+    OccupancyGrid.established_at). Each table has one row more, index k, for points off
+    the window: no wall point, an end (so no distance), not new. The tables are per
+    wall cell, not per window cell: a field is made every few scans and read at a few
+    hundred returns, so what a return needs is looked up when it is asked for."""
 
     wall: NDArray[np.int32]
     point: NDArray[np.float64]
     normal: NDArray[np.float64]
+    end: NDArray[np.bool_]
+    new: NDArray[np.bool_]
     origin: NDArray[np.float64]
     resolution: float
-    #: Per wall cell (k,): where the memory's wall ends but the wall may go on
-    #: (:func:`_ends`).
-    end: NDArray[np.bool_] | None = None
-    #: Per wall cell (k,): established fewer than MIN_WALL_SCANS scans before the field
-    #: was made (OccupancyGrid.established_at).
-    new: NDArray[np.bool_] | None = None
 
     @property
     def shape(self) -> tuple[int, int]:
         """The window's (rows, columns)."""
         return self.wall.shape
-
-    def _walls(self, points: NDArray[np.float64]) -> tuple[NDArray, NDArray]:
-        """Which points (n, 2) lie in the window (n,), and the nearest wall cell of each
-        of those (its index in the tables)."""
-        cells = np.floor((points - self.origin) / self.resolution).astype(np.int64)
-        h, w = self.wall.shape
-        inside = (cells[:, 0] >= 0) & (cells[:, 1] >= 0) & (cells[:, 0] < w) \
-            & (cells[:, 1] < h)
-        return inside, self.wall[cells[inside, 1], cells[inside, 0]]
 
     def lookup(self, points: NDArray[np.float64]
                ) -> tuple[NDArray, NDArray, NDArray, NDArray]:
@@ -142,21 +133,17 @@ class DistanceField:
         where the memory's wall ends but the wall may go on (a return there may lie
         beyond it, where the memory has not seen the wall yet), and whether that wall
         cell has been established for fewer than MIN_WALL_SCANS scans (n,) (False
-        outside the window or without the grid's ``established_at``)."""
-        inside, k = self._walls(points)
-        n = len(points)
-        d = np.full(n, np.inf)
-        near = np.zeros((n, 2))
-        normal = np.zeros((n, 2))
-        young = np.zeros(n, bool)
-        near[inside] = self.point[k]
-        normal[inside] = self.normal[k]
-        d[inside] = np.hypot(*(points[inside] - near[inside]).T)
-        if self.end is not None:
-            d[np.flatnonzero(inside)[self.end[k]]] = np.inf
-        if self.new is not None:
-            young[inside] = self.new[k]
-        return near, normal, d, young
+        outside the window)."""
+        cells = np.floor((points - self.origin) / self.resolution).astype(np.int64)
+        h, w = self.wall.shape
+        col, row = cells[:, 0], cells[:, 1]
+        inside = (col >= 0) & (row >= 0) & (col < w) & (row < h)
+        k = np.where(inside, self.wall[np.clip(row, 0, h - 1), np.clip(col, 0, w - 1)],
+                     len(self.end) - 1)
+        near = self.point[k]
+        d = np.hypot(*(points - near).T)
+        d[self.end[k]] = np.inf
+        return near, self.normal[k], d, self.new[k]
 
     def at(self, points: NDArray[np.float64]) -> tuple[NDArray, NDArray, NDArray]:
         """Per point (n, 2): the nearest wall point, the normal, the distance
@@ -239,11 +226,14 @@ def distance_field(log_odds: NDArray[np.float32], origin: NDArray[np.float64],
     if hit_offset is not None:   # where the returns fell in the cell, not its centre
         point = point + hit_offset[r0:r1, c0:c1][wall_rows, wall_cols]
     normals = _normals(wall)
-    new = None if established_at is None else \
+    new = np.zeros(wall_rows.size, bool) if established_at is None else \
         established_at[r0:r1, c0:c1][wall_rows, wall_cols].astype(np.int64) \
         > scans - MIN_WALL_SCANS
-    return DistanceField(index[rows, cols], point, normals, corner, resolution,
-                         _ends(wall, normals, log_odds[r0:r1, c0:c1] < 0.0), new)
+    end = _ends(wall, normals, log_odds[r0:r1, c0:c1] < 0.0)
+    off = [False], [True]   # the row for points off the window: no wall, no distance
+    return DistanceField(index[rows, cols], np.vstack((point, [0.0, 0.0])),
+                         np.vstack((normals, [0.0, 0.0])), np.concatenate((end, off[1])),
+                         np.concatenate((new, off[0])), corner, resolution)
 
 
 def within_drift(predicted: NDArray[np.float64], matched: NDArray[np.float64],
