@@ -346,3 +346,37 @@ def test_with_the_alignment_the_robot_stands_until_its_first_walls_are_establish
         mapping = [s is Status.MAPPING for s in statuses]
         assert mapping == ([True] * (FIRST_SCANS - 1) + [False] * 2 if aligned
                            else [False] * (FIRST_SCANS + 1))
+
+
+@pytest.mark.core
+def test_the_distance_field_looks_up_the_nearest_wall_cell():
+    """DistanceField.lookup against brute force over the window's wall cells: for 400
+    points in and around the window, the nearest wall point is the centre of a wall cell
+    that is nearest to the point's cell (ties either way), its distance is to that point;
+    points off the window have no wall (distance inf, not young)."""
+    g = grid_with(room())
+    around = np.array([[-1.0, -0.5], [1.5, 1.0]])
+    f = distance_field(g.log_odds, g.origin, RES, around, 0.6)
+    h, w = f.shape
+    corner = f.origin
+    rows, cols = np.nonzero(g.log_odds[...] >= ESTABLISHED)
+    centres = g.origin + (np.column_stack((cols, rows)) + 0.5) * RES
+    in_window = np.all((centres >= corner) & (centres < corner + np.array([w, h]) * RES),
+                       axis=1)
+    centres = centres[in_window]
+    pts = np.random.default_rng(5).uniform(corner - 0.5, corner + np.array([w, h]) * RES
+                                           + 0.5, (400, 2))
+    near, normal, d, young = f.lookup(pts)
+    cells = np.floor((pts - corner) / RES)
+    inside = np.all((cells >= 0) & (cells < [w, h]), axis=1)
+    assert 50 < inside.sum() < 400
+    assert np.all(np.isinf(d[~inside])) and not young.any()
+    cell_centres = corner + (cells[inside] + 0.5) * RES
+    best = np.min(np.hypot(*(cell_centres[:, None] - centres[None]).transpose(2, 0, 1)),
+                  axis=1)
+    got = np.hypot(*(cell_centres - near[inside]).T)
+    np.testing.assert_allclose(got, best, atol=1e-9)
+    finite = np.isfinite(d[inside])   # (off a wall's open end: inf)
+    np.testing.assert_allclose(d[inside][finite],
+                               np.hypot(*(pts[inside] - near[inside]).T)[finite])
+    np.testing.assert_allclose(np.hypot(*normal[inside].T), 1.0)

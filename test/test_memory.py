@@ -1,6 +1,7 @@
 """Occupancy memory and navigation field (core/occupancy.py, core/navigation.py)."""
 
 import math
+import threading
 
 from hypothesis import given, settings
 from hypothesis import strategies as st
@@ -231,7 +232,7 @@ def _first_fields(cfg: PlannerConfig) -> NavigationMemory:
 
 
 def test_memory_recomputes_on_a_new_goal_and_at_most_every_field_period():
-    mem = _first_fields(PlannerConfig(field_period=1.0))
+    mem = _first_fields(PlannerConfig(field_period=1.0, field_worker=False))   # in the call
     mem.field_for((0, 0), (0.0, 1.0), now=1.5)
     assert mem.recomputed                        # grid changed, field_period over
     mem.integrate(Scan(*enclosure_scan(1.2), 3.0), (0.0, 0.0, 0.0))
@@ -245,6 +246,10 @@ def test_with_the_worker_the_map_changes_reach_the_field_at_the_next_call():
     before = mem.field
     assert mem.field_for((0, 0), (0.0, 1.0), now=1.5) is before   # grid changed, period
     assert not mem.recomputed                    # over: marched in the worker ...
+    # ... not before the cycle is over (start_marching: DecisionLoop.after_tick) ...
+    assert not any(t.name.startswith('field') for t in threading.enumerate())
+    mem.start_marching()
+    assert any(t.name.startswith('field') for t in threading.enumerate())
     after = mem.field_for((0, 0), (0.0, 1.0), now=1.7)
     assert mem.recomputed and after is not before   # ... and taken at the next call
     # the field marched in the worker is the one the cycle would have computed

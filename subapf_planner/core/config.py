@@ -137,10 +137,10 @@ class PlannerConfig:
     field_period: float = param(1.0, 'Shortest time between two field computations (sooner '
                                 'for a new goal, or when the robot leaves the patch)', 's',
                                 0.0, 60.0)
-    field_worker: bool = param(False, "A field that only brings the map's changes in is "
-                               'marched on a worker thread and used from the next cycle: '
-                               'a tick never waits for it, but among people the map reaches '
-                               'the field a cycle late (README, Performance)')
+    field_worker: bool = param(True, "A field that only brings the map's changes in is "
+                               'marched on a worker thread between cycles and used from the '
+                               'next cycle: a tick never waits for it (the map reaches the '
+                               'field a cycle late; README, Performance)')
     scan_alignment: bool = param(True, 'Match each scan to the memory before it is written '
                                  '(core/alignment.py): drifting wheel odometry is corrected, '
                                  'and the memory, the field and the goal live in the '

@@ -121,9 +121,15 @@ class DecisionLoop:
         """The occupancy memory (read it, do not change it)."""
         return self.planner.memory.grid
 
+    def after_tick(self) -> None:
+        """Start the work that runs between this tick and the next (the navigation field
+        marched on a worker thread: core/memory.py); call it once the tick's command is
+        out. The next tick's decisions are the same whether it is called or not."""
+        self.planner.memory.start_marching()
+
     def settle(self) -> None:
-        """Let work started after a tick finish (the navigation field marched between
-        cycles: core/memory.py); the next tick's decisions are the same either way."""
+        """Start the work between ticks and let it finish (for a caller with no idle
+        time between ticks: the bench); the next tick's decisions are the same."""
         self.planner.memory.settle()
 
     def seed_command(self, command: tuple[float, float]) -> None:

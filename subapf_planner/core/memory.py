@@ -7,7 +7,7 @@ the field covers, or, when the occupied cells changed, at most every
 core/navigation.py). A scan that only confirms what the map holds changes no
 occupied cell and costs no field.
 
-With ``field_worker`` (off by default), a field that only brings the map's changes
+With ``field_worker`` (on by default), a field that only brings the map's changes
 in is marched on a worker thread from the cycle's map, while the cycle goes on
 with the field it has, and is taken at the next call (waited for if it is not
 done yet); a field needed at once (a new goal, a place avoided or opened again,
@@ -76,7 +76,10 @@ class NavigationMemory:
         self._distance_age = 0
         #: Places tried and not passed: (x, y, radius [m], until [s]) (see ``avoid``).
         self.avoided: list[tuple[float, float, float, float]] = []
-        #: The field being marched in the worker, with its (key, time) once taken.
+        #: A field to march between cycles: its inputs, taken in the cycle, with its
+        #: (key, time) (start_marching starts it) ...
+        self._due: tuple[tuple, tuple, float] | None = None
+        #: ... and once started, the field being marched in the worker.
         self._pending: tuple[Future, tuple, float] | None = None
         self._worker: ThreadPoolExecutor | None = None
 
@@ -100,26 +103,39 @@ class NavigationMemory:
         self._drop_pending()
 
     def _drop_pending(self) -> None:
-        """Forget the field being marched (its result, once done, is dropped)."""
+        """Forget the field due or being marched (its result, once done, is dropped)."""
+        self._due = None
         if self._pending is not None:
             self._pending[0].cancel()
             self._pending = None
 
+    def start_marching(self) -> None:
+        """Start marching the field the last call took the map for (if any) on the worker
+        thread. For after the cycle's command is out: the marching holds the GIL
+        (scikit-fmm does not release it), so started within the cycle it would hold up
+        the rest of it. Not called, the next call marches it itself (the same field)."""
+        if self._due is None:
+            return
+        args, key, now = self._due
+        self._due = None
+        if self._worker is None:
+            self._worker = ThreadPoolExecutor(max_workers=1, thread_name_prefix='field')
+            weakref.finalize(self, self._worker.shutdown, wait=False)
+        self._pending = (self._worker.submit(self._compute, *args), key, now)
+
     def settle(self) -> None:
-        """Wait until the field being marched (if any) is done; the next call takes it
-        as it would have anyway. What a node's idle time between ticks gives the worker,
-        for a caller with no idle time (the bench's simulator holds the GIL)."""
+        """Start the field due and wait until it is done; the next call takes it as it
+        would have anyway. What a node's idle time between ticks gives the worker, for a
+        caller with no idle time (the bench's simulator holds the GIL)."""
+        self.start_marching()
         if self._pending is not None:
             self._pending[0].exception()
 
     def _march_later(self, goal: NDArray, position: NDArray, now: float) -> None:
-        """Start marching the field of the map as it is now on the worker thread."""
-        if self._worker is None:
-            self._worker = ThreadPoolExecutor(max_workers=1, thread_name_prefix='field')
-            weakref.finalize(self, self._worker.shutdown, wait=False)
-        job = self._worker.submit(self._compute, self._blocked(now), self.grid.origin.copy(),
-                                  goal, position)
-        self._pending = (job, self._key(goal), now)
+        """Take the map as it is now for a field to march between cycles
+        (start_marching); the next call takes that field."""
+        self._due = ((self._blocked(now), self.grid.origin.copy(), goal, position),
+                     self._key(goal), now)
 
     def _compute(self, blocked: NDArray[np.bool_], origin: NDArray, goal: NDArray,
                  position: NDArray) -> tuple[NavigationField | None, float]:
@@ -247,6 +263,7 @@ class NavigationMemory:
         p = np.asarray(position, float)[:2]
         g = np.asarray(goal, float)[:2]
         self.recomputed = False
+        self.start_marching()   # (if nobody did since the last call)
         if self._pending is not None:   # the field marched since the last call
             job, key, started = self._pending
             self._pending = None

@@ -294,6 +294,7 @@ class PlannerNode(Node):
         self._last_state = decision.text
         if listened(self.status_pub):
             self.status_pub.publish(String(data=decision.text))
+        self.ctl.after_tick()   # the field marched until the next tick, not in this one
 
     def _publish_views(self, decision, tick) -> None:
         """~/markers at marker_rate and ~/correction each cycle, each only while

@@ -47,6 +47,7 @@ def replay(path: str, cfg: PlannerConfig, limits: Supervision, names: dict[str, 
             leading = skipped == len(replayed) and (ctl.scan is None or ctl.pose is None
                                                     or ctl.goal is None)
             decision = ctl.tick(t)
+            ctl.after_tick()   # as the node does once its command is out
             if leading:
                 skipped += 1
                 ctl.seed_command(command)   # the node's state after what it published
