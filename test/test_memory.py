@@ -283,3 +283,9 @@ def test_a_thinned_polyline_keeps_its_ends_and_its_spacing():
     assert np.all(gaps[:-1] >= 0.25 - 1e-9) and np.all(gaps[:-1] <= 0.3 + 1e-9)
     assert len(thin) < len(line)
     np.testing.assert_allclose(thin_polyline(line[:2], 0.25), line[:2])   # too short: as is
+    # a path that zigzags on 0.1 m blocks (down-right, up-right: 0.28 m along it, 0.2 m
+    # across): its points stay 0.25 m apart in a straight line
+    zigzag = np.column_stack((np.arange(0.0, 3.05, 0.1), 0.1 * (np.arange(31) % 2)))
+    thin = thin_polyline(zigzag, 0.25)
+    assert np.all(np.hypot(*np.diff(thin[:-1], axis=0).T) >= 0.25 - 1e-9)
+    np.testing.assert_allclose(thin[[0, -1]], zigzag[[0, -1]])

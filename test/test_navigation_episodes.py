@@ -75,7 +75,9 @@ def test_a_gap_it_cannot_pass_is_marked_tried_and_the_other_way_taken():
     (samples kept 0.135 m from laser points) cannot pass, and the robot stands with
     no_safe_move. Without recoveries the progress checker abandons the goal; with them
     the gap is marked tried, the field leads round the wall's end, and the goal is
-    reached."""
+    reached. (The no-recoveries run marches the field in the tick: with the field
+    marched between ticks, the default, the robot happens not to stand at the gap at all
+    in this world and drives round at once.)"""
     gap, end = 0.25, 5.5
     doc = {'name': 'narrow', 'start': [0.0, 0.0, 1.5708], 'goal': [0.0, 3.0],
            'time_limit': 200, 'bounds': [-2.5, -1.0, end + 2.5, 4.0],
@@ -84,7 +86,8 @@ def test_a_gap_it_cannot_pass_is_marked_tried_and_the_other_way_taken():
                          {'box': {'center': [(gap / 2 + end) / 2, 1.5],
                                   'size': [end - gap / 2, 0.1]}}]}
     world = parse_world(doc)
-    given_up = run_episode(world, PlannerConfig(), limits=Supervision(recoveries=0))
+    given_up = run_episode(world, PlannerConfig(field_worker=False),
+                           limits=Supervision(recoveries=0))
     assert given_up.outcome is Outcome.ABANDONED
     assert given_up.statuses.get('no_safe_move', 0) > 10
     result = run_episode(world, PlannerConfig())

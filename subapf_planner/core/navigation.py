@@ -215,18 +215,19 @@ class NavigationField:
 
 
 def thin_polyline(points: ArrayLike, spacing: float) -> NDArray[np.float64]:
-    """The points (k, 2) of a polyline at least ``spacing`` [m] apart along it, walking
-    from the first, which is kept, as is the last."""
+    """The points (k, 2) of a polyline, walking from the first, which is kept: each next
+    one the first at least ``spacing`` [m] from the last one kept, in a straight line (a
+    path that zigzags on the grid keeps its points that far apart too), and the last."""
     p = np.asarray(points, float).reshape(-1, 2)
     if len(p) < 3 or spacing <= 0.0:
         return p.copy()
-    along = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(p, axis=0).T))])
     keep = [0]
-    while True:   # the next point at least ``spacing`` further along
-        nxt = int(np.searchsorted(along, along[keep[-1]] + spacing - 1e-9))
-        if nxt >= len(p) - 1:
+    while True:   # the next point at least ``spacing`` from the last one kept
+        far = np.flatnonzero(np.hypot(*(p[keep[-1] + 1:] - p[keep[-1]]).T)
+                             >= spacing - 1e-9)
+        if not far.size or keep[-1] + 1 + int(far[0]) >= len(p) - 1:
             break
-        keep.append(nxt)
+        keep.append(keep[-1] + 1 + int(far[0]))
     keep.append(len(p) - 1)
     return p[keep]
 
