@@ -303,8 +303,8 @@ def landmarks(points: NDArray[np.float64], pieces: NDArray[np.int64],
 def _taking_part(field: DistanceField, world: NDArray[np.float64],
                  small: NDArray[np.bool_]) -> tuple[NDArray, NDArray, NDArray, NDArray]:
     """For the returns at ``world`` (n, 2) [m]: the nearest wall point, the normal, the
-    distance (DistanceField.at) and which take part: beside a wall (:func:`_beside`), and
-    for those of ``small`` pieces, a wall that has stood (DistanceField.young)."""
+    distance (DistanceField.lookup) and which take part: beside a wall (:func:`_beside`),
+    and for those of ``small`` pieces, a wall that has stood (not young)."""
     near, normal, d, young = field.lookup(world)
     use = _beside(world, near, normal, d, field.resolution) & ~(small & young)
     return near, normal, d, use
