@@ -276,7 +276,7 @@ def test_small_things_match_only_walls_that_have_stood_min_wall_scans():
     for _ in range(MIN_WALL_SCANS + 2):
         f = distance_field(g.log_odds, g.origin, RES, np.array([[1.0, 0.0]]), 0.4,
                            g.hit_offset, g.established_at, g.scans)
-        assert f.young(np.array([[1.0, 0.0]]))[0] == (g.scans - 3 < MIN_WALL_SCANS)
+        assert f.lookup(np.array([[1.0, 0.0]]))[3][0] == (g.scans - 3 < MIN_WALL_SCANS)
         g.update(scan, (0.0, 0.0, 0.0))
     ranges[0] = 2.0                                   # it went: beams now pass through
     for _ in range(10):

@@ -145,16 +145,6 @@ class DistanceField:
         d[self.end[k]] = np.inf
         return near, self.normal[k], d, self.new[k]
 
-    def at(self, points: NDArray[np.float64]) -> tuple[NDArray, NDArray, NDArray]:
-        """Per point (n, 2): the nearest wall point, the normal, the distance
-        (:meth:`lookup`)."""
-        return self.lookup(points)[:3]
-
-    def young(self, points: NDArray[np.float64]) -> NDArray[np.bool_]:
-        """Per point (n, 2): its nearest wall cell has been established for fewer than
-        MIN_WALL_SCANS scans (:meth:`lookup`)."""
-        return self.lookup(points)[3]
-
 
 def _ends(wall: NDArray[np.bool_], normal: NDArray[np.float64],
           seen_free: NDArray[np.bool_]) -> NDArray[np.bool_]:
@@ -230,10 +220,10 @@ def distance_field(log_odds: NDArray[np.float32], origin: NDArray[np.float64],
         established_at[r0:r1, c0:c1][wall_rows, wall_cols].astype(np.int64) \
         > scans - MIN_WALL_SCANS
     end = _ends(wall, normals, log_odds[r0:r1, c0:c1] < 0.0)
-    off = [False], [True]   # the row for points off the window: no wall, no distance
+    # one row more for points off the window: no wall point, an end (no distance), not new
     return DistanceField(index[rows, cols], np.vstack((point, [0.0, 0.0])),
-                         np.vstack((normals, [0.0, 0.0])), np.concatenate((end, off[1])),
-                         np.concatenate((new, off[0])), corner, resolution)
+                         np.vstack((normals, [0.0, 0.0])), np.append(end, True),
+                         np.append(new, False), corner, resolution)
 
 
 def within_drift(predicted: NDArray[np.float64], matched: NDArray[np.float64],
@@ -319,7 +309,7 @@ def align(base_points: NDArray[np.float64], predicted: NDArray[np.float64],
     cluster label, n), a match is accepted only when its matched returns make MIN_PIECES
     landmarks (:func:`landmarks`; ``mover_size`` [m] the longest a mover can be), and
     the returns of pieces no longer than that match only walls that have stood
-    MIN_WALL_SCANS (DistanceField.young)."""
+    MIN_WALL_SCANS (DistanceField.lookup)."""
     prior = np.asarray(predicted, float).copy()
     if field is None or len(base_points) < MIN_MATCHED:
         return Match(prior, False, 0, math.nan)

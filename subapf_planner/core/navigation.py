@@ -225,9 +225,10 @@ def thin_polyline(points: ArrayLike, spacing: float) -> NDArray[np.float64]:
     while True:   # the next point at least ``spacing`` from the last one kept
         far = np.flatnonzero(np.hypot(*(p[keep[-1] + 1:] - p[keep[-1]]).T)
                              >= spacing - 1e-9)
-        if not far.size or keep[-1] + 1 + int(far[0]) >= len(p) - 1:
+        nxt = keep[-1] + 1 + int(far[0]) if far.size else len(p)
+        if nxt >= len(p) - 1:
             break
-        keep.append(keep[-1] + 1 + int(far[0]))
+        keep.append(nxt)
     keep.append(len(p) - 1)
     return p[keep]
 
