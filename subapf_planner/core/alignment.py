@@ -54,6 +54,7 @@ from scipy import ndimage
 
 from .occupancy import ESTABLISHED
 from .robot import to_parent
+from .tracking import extents
 
 #: A piece of the scan no longer than a mover (a person, a chair, a post) is matched only
 #: to cells established this many scans ago or more (5 s at the LDS-01's 5 Hz): a person
@@ -89,6 +90,9 @@ PRIOR_SIGMA_YAW = 0.02
 #: Standard deviation of one return's distance to the wall [m] (the laser's noise plus
 #: half a cell).
 RETURN_SIGMA = 0.03
+#: The prior's information (inverse covariance) on (x, y, yaw), read-only.
+INFO_PRIOR = np.diag([PRIOR_SIGMA_XY ** -2, PRIOR_SIGMA_XY ** -2, PRIOR_SIGMA_YAW ** -2])
+INFO_PRIOR.setflags(write=False)
 #: A match that moves the prediction more than this is refused [m], [rad].
 MAX_STEP_XY = 0.03
 MAX_STEP_YAW = 0.03
@@ -103,28 +107,23 @@ DRIFT_YAW_PER_RAD = 0.05
 @dataclass(frozen=True)
 class DistanceField:
     """For the cells of a window (rows = y; cell (0, 0) with its corner at ``origin``
-    [m]; ``shape`` (h, w)): which established obstacle cell is the nearest (``wall``,
-    (h, w): its index in the wall-cell tables), and per wall cell (k of them) the wall
-    point (k, 2) [m], the wall's unit normal there (k, 2), whether the memory's wall
-    ends there but the wall may go on (``end``, k: :func:`_ends`) and whether it was
-    established fewer than MIN_WALL_SCANS scans before the field was made (``new``, k:
-    OccupancyGrid.established_at). Each table has one row more, index k, for points off
-    the window: no wall point, an end (so no distance), not new. The tables are per
-    wall cell, not per window cell: a field is made every few scans and read at a few
-    hundred returns, so what a return needs is looked up when it is asked for."""
+    [m]; ``shape`` (h, w)): which established obstacle cell is the nearest (``index``,
+    h * w + 1, the cells flat, row by row, then one for points off the window: its row
+    in ``table``), and per wall cell (k of them) a row of ``table`` (k + 1, 6): the wall
+    point (x, y) [m], the wall's unit normal there (x, y), ``inf`` where the memory's
+    wall ends but the wall may go on (:func:`_ends`; else 0: added to the distance, it
+    leaves no distance there) and 1 where it was established fewer than MIN_WALL_SCANS
+    scans before the field was made (OccupancyGrid.established_at; else 0). The last
+    row, k, is for points off the window: no wall point, an end (no distance), not
+    new. The table is per wall cell, not per window cell: a field is made every few
+    scans and read at a few hundred returns, so what a return needs is looked up, in
+    one gather, when it is asked for."""
 
-    wall: NDArray[np.int32]
-    point: NDArray[np.float64]
-    normal: NDArray[np.float64]
-    end: NDArray[np.bool_]
-    new: NDArray[np.bool_]
+    index: NDArray[np.int32]
+    table: NDArray[np.float64]
+    shape: tuple[int, int]
     origin: NDArray[np.float64]
     resolution: float
-
-    @property
-    def shape(self) -> tuple[int, int]:
-        """The window's (rows, columns)."""
-        return self.wall.shape
 
     def lookup(self, points: NDArray[np.float64]
                ) -> tuple[NDArray, NDArray, NDArray, NDArray]:
@@ -135,15 +134,13 @@ class DistanceField:
         cell has been established for fewer than MIN_WALL_SCANS scans (n,) (False
         outside the window)."""
         cells = np.floor((points - self.origin) / self.resolution).astype(np.int64)
-        h, w = self.wall.shape
+        h, w = self.shape
         col, row = cells[:, 0], cells[:, 1]
         inside = (col >= 0) & (row >= 0) & (col < w) & (row < h)
-        k = np.where(inside, self.wall[np.clip(row, 0, h - 1), np.clip(col, 0, w - 1)],
-                     len(self.end) - 1)
-        near = self.point[k]
-        d = np.hypot(*(points - near).T)
-        d[self.end[k]] = np.inf
-        return near, self.normal[k], d, self.new[k]
+        found = self.table[self.index[np.where(inside, row * w + col, -1)]]
+        near = found[:, :2]
+        d = np.hypot(*(points - near).T) + found[:, 4]
+        return near, found[:, 2:4], d, found[:, 5] > 0.0
 
 
 def _ends(wall: NDArray[np.bool_], normal: NDArray[np.float64],
@@ -220,10 +217,12 @@ def distance_field(log_odds: NDArray[np.float32], origin: NDArray[np.float64],
         established_at[r0:r1, c0:c1][wall_rows, wall_cols].astype(np.int64) \
         > scans - MIN_WALL_SCANS
     end = _ends(wall, normals, log_odds[r0:r1, c0:c1] < 0.0)
-    # one row more for points off the window: no wall point, an end (no distance), not new
-    return DistanceField(index[rows, cols], np.vstack((point, [0.0, 0.0])),
-                         np.vstack((normals, [0.0, 0.0])), np.append(end, True),
-                         np.append(new, False), corner, resolution)
+    table = np.zeros((wall_rows.size + 1, 6))
+    table[:-1, 0:2], table[:-1, 2:4] = point, normals
+    table[:-1, 4], table[:-1, 5] = np.where(end, np.inf, 0.0), new
+    table[-1, 4] = np.inf   # off the window: no wall point, an end (no distance), not new
+    return DistanceField(np.append(index[rows, cols].ravel(), np.int32(wall_rows.size)),
+                         table, wall.shape, corner, resolution)
 
 
 def within_drift(predicted: NDArray[np.float64], matched: NDArray[np.float64],
@@ -271,12 +270,7 @@ def _beside(points: NDArray[np.float64], near: NDArray[np.float64],
 
 def _extents(points: NDArray[np.float64], pieces: NDArray[np.int64]) -> NDArray[np.float64]:
     """The extent (bounding-box diagonal [m]) of each piece, by label (max label + 1,)."""
-    k = int(pieces.max()) + 1 if len(pieces) else 0
-    lo = np.full((k, 2), np.inf)
-    hi = np.full((k, 2), -np.inf)
-    np.minimum.at(lo, pieces, points)
-    np.maximum.at(hi, pieces, points)
-    return np.hypot(*(hi - lo).T)
+    return extents(points, pieces, int(pieces.max()) + 1 if len(pieces) else 0)
 
 
 def landmarks(points: NDArray[np.float64], pieces: NDArray[np.int64],
@@ -285,8 +279,9 @@ def landmarks(points: NDArray[np.float64], pieces: NDArray[np.int64],
     cluster labels, m) make: each piece with MIN_PIECE_MATCHED of them counts one, and one
     whose matched points span more than ``mover_size`` [m] (no mover is that long: a
     wall) counts MIN_PIECES."""
-    labels, counts = np.unique(pieces, return_counts=True)
-    span = _extents(points, pieces)[labels[counts >= MIN_PIECE_MATCHED]]
+    if not len(pieces):
+        return 0
+    span = _extents(points, pieces)[np.bincount(pieces) >= MIN_PIECE_MATCHED]
     return int(np.sum(np.where(span > mover_size, MIN_PIECES, 1)))
 
 
@@ -316,7 +311,6 @@ def align(base_points: NDArray[np.float64], predicted: NDArray[np.float64],
     small = np.zeros(len(base_points), bool) if pieces is None else \
         _extents(base_points, pieces)[pieces] <= mover_size
     pose = prior.copy()
-    info_prior = np.diag([PRIOR_SIGMA_XY ** -2, PRIOR_SIGMA_XY ** -2, PRIOR_SIGMA_YAW ** -2])
     w_ret = RETURN_SIGMA ** -2
     for _ in range(ITERATIONS):
         world = to_parent(pose, base_points)
@@ -331,8 +325,8 @@ def align(base_points: NDArray[np.float64], predicted: NDArray[np.float64],
         jac = np.column_stack((n[:, 0], n[:, 1], np.einsum('ij,ij->i', n, dyaw)))
         off = pose - prior
         off[2] = math.remainder(off[2], 2 * math.pi)
-        h = w_ret * jac.T @ jac + info_prior
-        b = w_ret * jac.T @ res + info_prior @ off
+        h = w_ret * jac.T @ jac + INFO_PRIOR
+        b = w_ret * jac.T @ res + INFO_PRIOR @ off
         step = -np.linalg.solve(h, b)
         pose = pose + step
         if np.hypot(step[0], step[1]) < CONVERGED and abs(step[2]) < CONVERGED:

@@ -149,6 +149,22 @@ def clusters(points: NDArray[np.float64], gap: float) -> tuple[NDArray[np.int64]
     return labels, count
 
 
+def extents(points: NDArray[np.float64], labels: NDArray[np.int64],
+            count: int) -> NDArray[np.float64]:
+    """The extent (bounding-box diagonal [m]) of each of ``count`` clusters (count,) of
+    ``points`` (n, 2) by their ``labels`` (n,); inf for a label no point has. A
+    scan's clusters are runs of points in beam order (:func:`clusters`: the last run
+    may carry the first's label): reduced per run, then per label over the runs."""
+    lo = np.full((count, 2), np.inf)
+    hi = np.full((count, 2), -np.inf)
+    if len(labels):
+        starts = np.flatnonzero(np.concatenate(([True], labels[1:] != labels[:-1])))
+        run = labels[starts]
+        np.minimum.at(lo, run, np.minimum.reduceat(points, starts, axis=0))
+        np.maximum.at(hi, run, np.maximum.reduceat(points, starts, axis=0))
+    return np.hypot(*(hi - lo).T)
+
+
 class Tracker:
     """Tracks of one robot. Not thread-safe."""
 
@@ -291,11 +307,7 @@ def _cluster_features(points: NDArray[np.float64], labels: NDArray[np.int64], co
     n = np.bincount(labels, minlength=count).astype(float)
     cents = np.column_stack([np.bincount(labels, points[:, i], count) for i in (0, 1)]) \
         / n[:, None]
-    lo = np.full((count, 2), np.inf)
-    hi = np.full((count, 2), -np.inf)
-    np.minimum.at(lo, labels, points)
-    np.maximum.at(hi, labels, points)
-    sizes = np.hypot(*(hi - lo).T)
+    sizes = extents(points, labels, count)
     new = np.bincount(labels, log_odds_at < FREE_LOG_ODDS, count) / n
     mapped = np.bincount(labels, log_odds_at >= WALL_LOG_ODDS, count) / n
     d = points - cents[labels]
