@@ -161,6 +161,7 @@ def test_the_planner_corrects_drift_while_it_drives_and_not_while_it_stands():
         planner.step(np.asarray(odom, float), (2.0, -1.0),
                      Scan(ranges_from(walls, true), 0.0, math.radians(1.0), 0.12, 3.5,
                           0.2 * k), now=0.2 * k)
+        planner.after_tick()   # the scan matched once the command is out, as the node does
         return np.asarray(planner.correction)
 
     for _ in range(6):                                   # the room mapped, no drift
@@ -171,6 +172,45 @@ def test_the_planner_corrects_drift_while_it_drives_and_not_while_it_stands():
     assert c[0] == pytest.approx(0.02, abs=0.008) and abs(c[1]) < 0.008
     for _ in range(4):                                   # standing: nothing moves it
         assert np.array_equal(scan_at((1.04, 0.0, 0.005), (1.0, 0.0, 0.0)), c)
+
+@pytest.mark.sim
+def test_the_scan_goes_into_the_memory_after_the_command_the_same_either_way():
+    """A tick plans with the memory as the scan before left it (its own scan is among
+    its obstacles); after_tick (the node: once cmd_vel is out) matches the scan to the
+    memory and writes it. A caller that never calls after_tick gets the same done first
+    thing in the next tick: the same commands, correction and memory, here with
+    drifting odometry through a cluttered field."""
+    from subapf_planner.core.loop import DecisionLoop
+    from subapf_planner.ros.paths import shipped_worlds_dir
+    from subapf_planner.sim.simulator import BurgerSim, SimConfig
+    from subapf_planner.sim.world import load_world
+    world = load_world(shipped_worlds_dir() / 'cluttered_field.yaml')
+    told, left = DecisionLoop(PlannerConfig()), DecisionLoop(PlannerConfig())
+    for ctl in (told, left):
+        ctl.set_goal(np.asarray(world.goal, float), in_map=True)
+    sim_cfg = SimConfig(odom_distance_scale=1.02, odom_yaw_scale=1.03)
+    with BurgerSim(world, sim_cfg) as sim:
+        start = sim.true_pose()
+        for _ in range(30):
+            odom, scan = sim.odometry()[0], sim.scan()
+            for ctl in (told, left):
+                ctl.update_odom(sim.time, odom, sim.time)
+                ctl.update_scan(scan, sim.time)
+            scans = told.grid.scans
+            decision = told.tick(sim.time)
+            assert told.grid.scans == scans          # not written in the tick ...
+            told.after_tick()
+            assert told.grid.scans == scans + 1      # ... but once the command is out
+            assert left.tick(sim.time).command == decision.command
+            sim.set_command(*decision.command)
+            sim.step(0.2)
+        driven = float(np.hypot(*(sim.true_pose()[:2] - start[:2])))
+    left.settle()
+    told.settle()
+    assert driven > 0.5
+    assert told.planner.correction == left.planner.correction != (0.0, 0.0, 0.0)
+    np.testing.assert_array_equal(told.grid.log_odds, left.grid.log_odds)
+
 
 def _drive_between(world, sim_cfg, legs):
     """Drive start -> goal -> start ... (``legs`` times there and back, each goal a place

@@ -144,6 +144,7 @@ def test_the_memory_forgets_a_walker_and_keeps_the_wall():
             ranges = scan_of(pose, [(walker, 0.25)], walls=[2.5])
             planner.step(pose, (3.0, 3.0), Scan(ranges, 0.0, 2 * math.pi / N, 0.12, 3.5, t),
                          now=t)
+            planner.after_tick()   # the scan written once the command is out
             grid = planner.memory.grid
             rows, cols = np.nonzero(grid.occupied())
             xy = grid.centre_of(np.column_stack((rows, cols)))

@@ -122,15 +122,16 @@ class DecisionLoop:
         return self.planner.memory.grid
 
     def after_tick(self) -> None:
-        """Start the work that runs between this tick and the next (the navigation field
-        marched on a worker thread: core/memory.py); call it once the tick's command is
-        out. The next tick's decisions are the same whether it is called or not."""
-        self.planner.memory.start_marching()
+        """Do the work that runs between this tick and the next (Planner.after_tick: the
+        scan into the memory, then the navigation field marched on a worker thread);
+        call it once the tick's command is out. The next tick's decisions are the same
+        whether it is called or not."""
+        self.planner.after_tick()
 
     def settle(self) -> None:
-        """Start the work between ticks and let it finish (for a caller with no idle
-        time between ticks: the bench); the next tick's decisions are the same."""
-        self.planner.memory.settle()
+        """The work between ticks done and finished (for a caller with no idle time
+        between ticks: the bench); the next tick's decisions are the same."""
+        self.planner.settle()
 
     def seed_command(self, command: tuple[float, float]) -> None:
         """The command the robot was last sent by someone else (a replay that starts

@@ -3,14 +3,20 @@
 One cycle of :meth:`Planner.step` (the decision loop, core/loop.py, calls it once
 per period):
 
-1. **perceive**: with ``attraction_field: geodesic`` (the default) and
-   ``scan_alignment``, the scan is first matched to the occupancy memory
-   (alignment.py): the correction it finds (odom -> the memory's frame) places
-   the robot, the scan and the goal from then on, so drifting odometry does not
-   draw walls twice; the scan's valid returns -> point obstacles (scan.py, with
-   the laser mounting of robot.py); with the geodesic attraction the scan also
-   goes into the occupancy memory (memory.py); moving obstacles are tracked
-   (tracking.py) and their points kept out of the memory;
+1. **perceive**: the scan's valid returns -> point obstacles (scan.py, with the
+   laser mounting of robot.py), placed with the scan alignment's correction
+   (odom -> the memory's frame) as the last scan left it; moving obstacles are
+   tracked (tracking.py). With ``attraction_field: geodesic`` (the default) the
+   scan then goes into the occupancy memory (memory.py), but only once the
+   cycle's command is out (:meth:`Planner.perceive`, from
+   DecisionLoop.after_tick; the next step does it first if nobody did, so the
+   result is the same): with ``scan_alignment`` it is matched to the memory
+   (alignment.py; the correction it finds places the next cycle's robot, scan
+   and goal, so drifting odometry does not draw walls twice), then the trail of
+   what moved is cleared and the scan written, the moving tracks' points kept
+   out. The command does not wait for the memory; the memory a cycle plans with
+   holds the scans up to the one before (the scan itself is in the cycle's
+   obstacles), its correction is one scan old (what odometry drifts in 0.2 s);
 2. **gate**: the inputs (:func:`input_status`: non-finite pose or goal; a scan
    with a bad geometry) and the goal (:func:`goal_status`: reached, inside an
    obstacle; with the memory, unreachable through it) each stop the robot with
@@ -207,6 +213,9 @@ class Planner:
         self.tracker = _tracker(cfg)
         self._escape: Escape | None = None   # the escape of the last cycle, if it evaded
         self._approach: tuple[NDArray, float] | None = None   # last cycle's goal, distance
+        #: The last cycle's scan for the memory (perceive): scan, odom pose of the scan,
+        #: goal (memory's frame), per beam transient, trail of what moved.
+        self._perception: tuple | None = None
         self._clear_alignment()
 
     @property
@@ -218,6 +227,7 @@ class Planner:
         if _tracker_settings(cfg) != _tracker_settings(self._cfg):
             self.tracker = _tracker(cfg)
         self._cfg = cfg
+        self._perception = None
         self.memory.reconfigure(cfg)
 
     def reset(self) -> None:
@@ -231,6 +241,7 @@ class Planner:
         self.reset()
         self.memory.forget()
         self.tracker.reset()
+        self._perception = None
         self._approach = None
         self._clear_alignment()
 
@@ -264,19 +275,17 @@ class Planner:
         if status is not None:
             return self._stop(PlanResult(Command(0.0, 0.0, status)))
         scan_pose = pose if scan_pose is None else np.asarray(scan_pose, float).ravel()
-        try:   # perceive: align (odom -> the memory's frame), then place the returns
-            if cfg.geodesic and cfg.scan_alignment:
-                self._align(scan, scan_pose)
+        self.perceive()   # the last cycle's scan, if after_tick did not take it in
+        odom_scan_pose = scan_pose
+        try:   # perceive: the returns placed with the correction of the last scan
             pose, scan_pose = self.in_map(pose), self.in_map(scan_pose)
             goal = goal if goal_in_map else self._anchored(goal)
             points = scan_to_points(scan, scan_pose, cfg.laser_mount, cfg.obstacle_range)
         except ScanError:
             return self._stop(PlanResult(Command(0.0, 0.0, Status.INVALID_SCAN)))
         tracks, transient = self._track(scan, points, now)
-        if cfg.geodesic:
-            if len(tracks.trail):
-                self.memory.clear(tracks.trail)
-            self.memory.integrate(scan, scan_pose, goal, transient)
+        if cfg.geodesic:   # the memory takes the scan in once the command is out
+            self._perception = (scan, odom_scan_pose, goal, transient, tracks.trail)
         seen = _situation(pose, goal, points)
         status = goal_status(cfg, seen['goal_distance'], goal, seen['obstacles'])
         if status is None and cfg.geodesic and cfg.scan_alignment and self._mapping():
@@ -308,9 +317,39 @@ class Planner:
         self.previous = (result.command.v, result.command.w)
         return result
 
+    def after_tick(self) -> None:
+        """The work between this cycle and the next, once the command is out: the scan
+        into the memory (perceive), then the navigation field marched on the memory's
+        worker (core/memory.py)."""
+        self.perceive()
+        self.memory.start_marching()
+
+    def settle(self) -> None:
+        """after_tick, and the field waited for (a caller with no idle time)."""
+        self.perceive()
+        self.memory.settle()
+
+    def perceive(self) -> None:
+        """Take the last cycle's scan into the memory, if not done yet: match it to the
+        memory (with ``scan_alignment``: the correction the next cycle places the robot
+        with), clear the trail of what moved, write it. For after the cycle's command is
+        out (DecisionLoop.after_tick): the command does not wait for the memory. Not
+        called, the next step calls it first: the same memory either way."""
+        if self._perception is None:
+            return
+        scan, scan_pose, goal, transient, trail = self._perception
+        self._perception = None
+        if self.cfg.scan_alignment:
+            self._align(scan, scan_pose)
+        if len(trail):
+            self.memory.clear(trail)
+        self.memory.integrate(scan, self.in_map(scan_pose), goal, transient)
+
     def _mapping(self) -> bool:
-        """Whether this cycle stands for the first walls (FIRST_SCANS; counts the cycle)."""
-        if self.memory.grid.scans >= FIRST_SCANS or self._mapping_cycles >= FIRST_SCANS:
+        """Whether this cycle stands for the first walls (FIRST_SCANS, the cycle's own
+        scan, which the memory takes after it, counted; counts the cycle)."""
+        scans = self.memory.grid.scans + (self._perception is not None)
+        if scans >= FIRST_SCANS or self._mapping_cycles >= FIRST_SCANS:
             return False
         self._mapping_cycles += 1
         return True

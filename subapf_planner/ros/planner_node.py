@@ -287,6 +287,9 @@ class PlannerNode(Node):
             handler(msg)
         if decision.command is not None:   # the command first, stamped with the tick time
             self._publish_cmd(*decision.command, stamp=tick.to_msg())
+        # then the scan into the memory (so ~/map shows it) and the field marched until
+        # the next tick: neither holds the command up
+        self.ctl.after_tick()
         self._publish_views(decision, tick)
         self._publish_memory(decision, tick)
         if decision.state.halted and decision.text != self._last_state:
@@ -294,7 +297,6 @@ class PlannerNode(Node):
         self._last_state = decision.text
         if listened(self.status_pub):
             self.status_pub.publish(String(data=decision.text))
-        self.ctl.after_tick()   # the field marched until the next tick, not in this one
 
     def _publish_views(self, decision, tick) -> None:
         """~/markers at marker_rate and ~/correction each cycle, each only while
@@ -308,10 +310,11 @@ class PlannerNode(Node):
             self.marker_pub.publish(markers_from_result(
                 result, self.options.odom_frame, tick.to_msg(), cfg.danger_distance,
                 cfg.robot_radius, cfg.voxel_size))
-        if cfg.geodesic and listened(self.correction_pub):
+        if cfg.geodesic and listened(self.correction_pub):   # with the tick's scan matched
+            correction = self.ctl.planner.correction
             self.correction_pub.publish(transform_msg(
                 self.options.map_frame, self.options.odom_frame,
-                (*result.correction[:2], 0.0), result.correction[2], now))
+                (*correction[:2], 0.0), correction[2], now))
 
     def _publish_memory(self, decision, tick) -> None:
         """~/plan for each new field, and when the robot moved PLAN_SPACING or PLAN_PERIOD

@@ -52,6 +52,9 @@ class EpisodeResult:
     #: Per new navigation field, how long computing it took [ms] (in the cycle, or on
     #: the memory's worker thread between cycles: core/memory.py).
     field_ms: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    #: Per tick, how long the work after its command took [ms]
+    #: (DecisionLoop.after_tick: the scan matched to and written into the memory).
+    after_ms: np.ndarray = field(default_factory=lambda: np.zeros(0))
 
     @property
     def cycles(self) -> int:
@@ -93,7 +96,7 @@ def run_episode(world: World, cfg: PlannerConfig, sim_cfg: SimConfig | None = No
     cfg = cfg.replace(goal_tolerance=min(cfg.goal_tolerance, world.goal_tolerance))
     ctl = DecisionLoop(cfg, limits)
     ctl.set_goal(np.asarray(world.goal, float), in_map=True)   # a place in the world
-    path, times, plan_ms, recomputed, statuses, field_ms = [], [], [], [], {}, []
+    path, times, plan_ms, recomputed, statuses, field_ms, after_ms = [], [], [], [], {}, [], []
     with BurgerSim(world, sim_cfg) as sim:
         while True:
             truth = sim.true_pose()
@@ -124,10 +127,14 @@ def run_episode(world: World, cfg: PlannerConfig, sim_cfg: SimConfig | None = No
             statuses[key] = statuses.get(key, 0) + 1
             if decision.command is not None:
                 sim.set_command(*decision.command)
+            t0 = time.perf_counter()
+            ctl.after_tick()   # as the node does once the command is out
+            after_ms.append((time.perf_counter() - t0) * 1e3)
             sim.step(cfg.period)
         final = float(np.hypot(*(sim.true_pose()[:2] - np.asarray(world.goal, float))))
         elapsed = sim.time
         hit_while_stopped = outcome is Outcome.COLLISION and sim.hit_while_stopped
     return EpisodeResult(world.name, label or cfg.method, outcome, elapsed, np.asarray(path),
                          np.asarray(plan_ms), final, statuses, np.asarray(recomputed, bool),
-                         np.asarray(times), hit_while_stopped, np.asarray(field_ms))
+                         np.asarray(times), hit_while_stopped, np.asarray(field_ms),
+                         np.asarray(after_ms))

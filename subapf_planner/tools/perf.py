@@ -3,10 +3,12 @@
 Drives closed-loop episodes (sim/episode.py: the node's controller, 360-beam
 scans from the simulator) on the given worlds and prints min / median / p99 /
 max of the time per planning cycle in ms: the whole tick, i.e. with the
-geodesic default the occupancy update, the navigation field when it is
+geodesic default the tracking, the navigation field when it is
 recomputed in the cycle (a new goal, the robot off the field's patch; a field that
 only brings the map's changes in is marched between cycles: core/memory.py), the
-APF step, the sampling and the command; and the time of each field computation,
+APF step, the sampling and the command; the time of the work after each tick's
+command (DecisionLoop.after_tick: the scan matched to the memory and written into
+it, which the next tick plans with); and the time of each field computation,
 wherever it ran. Also prints the memory the occupancy window and the largest field
 hold.
 """
@@ -77,6 +79,10 @@ def main(argv: list[str] | None = None) -> int:
         where = ("; those that only bring the map's changes in ran on the memory's worker "
                  'thread between cycles') if cfg.field_worker else ', all in their cycle'
         print(f'field computations ms (wall{where}): {_figures(marched)}')
+    after = np.concatenate([r.after_ms for r in runs])
+    if after.size and cfg.geodesic:
+        print(f'after the command ms (the scan matched to and written into the memory, '
+              f'and a field due handed to the worker): {_figures(after)}')
     if cfg.geodesic:
         field_bytes = cells * (FIELD_BYTES_PER_BLOCK / cfg.field_coarsening ** 2
                                + FIELD_BYTES_PER_MAP_CELL)
