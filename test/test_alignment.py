@@ -173,6 +173,7 @@ def test_the_planner_corrects_drift_while_it_drives_and_not_while_it_stands():
     for _ in range(4):                                   # standing: nothing moves it
         assert np.array_equal(scan_at((1.04, 0.0, 0.005), (1.0, 0.0, 0.0)), c)
 
+
 @pytest.mark.sim
 def test_the_scan_goes_into_the_memory_after_the_command_the_same_either_way():
     """A tick plans with the memory as the scan before left it (its own scan is among

@@ -59,7 +59,6 @@ LASER_IN_BASE_LINK = (ROBOT.laser.x, ROBOT.laser.y, ROBOT.laser.z - BASE_LINK_HE
 MIN_TIMER_PERIOD = 0.005
 
 
-
 @dataclass(frozen=True)
 class SimNodeOptions:
     """The sim node's own parameters (the rest: SimConfig and ScanFaults)."""
