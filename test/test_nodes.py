@@ -297,6 +297,24 @@ def test_scans_and_odometry_are_taken_at_the_tick_not_by_the_executor(harness):
     assert h.node.ctl.scan is not None and h.node.ctl.pose is not None
 
 
+def test_a_publisher_the_polled_inputs_cannot_hear_is_reported(harness, capfd):
+    """Odometry is polled at the tick (PolledGroup), but the subscription's QoS events
+    still run: a best-effort odometry publisher, which a reliable subscription never
+    hears, gets the node's warning (rclpy's default handler) instead of silence."""
+    h = harness()
+    quiet = h.peer.create_publisher(Odometry, 'odom', qos_profile_sensor_data)
+    odom = next(sub for sub, _ in h.node._inputs if sub.topic_name == '/odom')
+    handlers = odom.event_handlers
+    assert handlers and all(odom.callback_group.can_execute(e) for e in handlers)
+    assert not odom.callback_group.can_execute(odom)
+    warning = "New publisher discovered on topic 'odom', offering incompatible QoS"
+    seen = []
+    assert h.spin_until(lambda: (seen.append(capfd.readouterr().err), warning in seen[-1])[1])
+    quiet.publish(Odometry())
+    h.spin_until(lambda: False, timeout=0.5)   # two planning ticks: nothing came
+    assert h.node.ctl.pose is None
+
+
 def test_spin_node_bad_input_only_while_building_bugs_keep_their_traceback():
     """ros/spinning.py: a bad_input exception from the constructor is a clear message
     and exit code 2; the same exception type raised while spinning is a bug: it

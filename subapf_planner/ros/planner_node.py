@@ -14,7 +14,7 @@ Topics (relative, so namespaces and remapping work):
        sent only while something subscribes
 
 Scans and odometry are taken at the planning tick (ros/spinning.PolledGroup), so
-only the timer (and goals, parameters, /clock) wakes the process.
+only the timer (and goals, parameters, /clock, QoS events) wakes the process.
 
 The node only translates messages and parameters and drives one timer; the
 decisions are subapf_planner.core.loop's, the input checks ros/intake.py's.
