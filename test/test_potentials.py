@@ -14,6 +14,7 @@ from subapf_planner.core.potentials import (
     max_subharmonic_slope,
     repulsive_dr,
     repulsive_field,
+    repulsive_gradient,
     repulsive_laplacian,
     repulsive_value,
 )
@@ -60,6 +61,29 @@ def test_field_gradient_matches_finite_difference(kind, nearest):
         value = (lambda q: repulsive_field(kind, q, obs, 0.5, 9.0, nearest_only=nearest)[0][0])
         _, grad = repulsive_field(kind, p, obs, 0.5, 9.0, nearest_only=nearest)
         np.testing.assert_allclose(grad[0], numeric_gradient(value, p), rtol=1e-4, atol=1e-6)
+
+
+@pytest.mark.parametrize('kind', KINDS)
+@given(points=st.lists(st.tuples(st.floats(-3, 3), st.floats(-3, 3)), min_size=1, max_size=5),
+       obstacles=st.lists(st.tuples(st.floats(-3, 3), st.floats(-3, 3)), max_size=6),
+       nearest=st.booleans(), influence=st.sampled_from([0.5, 1.5, math.inf]))
+@settings(max_examples=60, deadline=None)
+def test_gradient_alone_is_the_fields_gradient(kind, points, obstacles, nearest, influence):
+    """repulsive_gradient (the APF step's) gives repulsive_field's gradient, bit for bit,
+    obstacle points on a point and no obstacles included."""
+    pts = np.asarray(points, float)
+    obs = np.asarray(obstacles, float).reshape(-1, 2)
+    if len(obs):
+        obs[0] = pts[0]   # one at distance zero
+    before = (pts.copy(), obs.copy())
+    grad = repulsive_gradient(kind, pts, obs, 0.5, 9.0, nearest_only=nearest,
+                              influence=influence)
+    _, expected = repulsive_field(kind, pts, obs, 0.5, 9.0, nearest_only=nearest,
+                                  influence=influence)
+    assert grad.shape == (len(pts), 2)
+    np.testing.assert_array_equal(grad, expected)
+    np.testing.assert_array_equal(pts, before[0])
+    np.testing.assert_array_equal(obs, before[1])
 
 
 @pytest.mark.parametrize('kind', ['quadratic', 'conic'])

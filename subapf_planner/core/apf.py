@@ -7,7 +7,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from .config import PlannerConfig
 from .navigation import NavigationField
-from .potentials import attractive_gradient, repulsive_field
+from .potentials import attractive_gradient, repulsive_gradient
 
 #: Planner method -> repulsion kind of potentials.py.
 REPULSION_OF_METHOD = {
@@ -30,7 +30,7 @@ def apf_force(points: ArrayLike, goal: ArrayLike, obstacles: ArrayLike,
     """
     kind = REPULSION_OF_METHOD[cfg.method]
     p = np.atleast_2d(np.asarray(points, float))
-    _, grad_rep = repulsive_field(kind, p, obstacles, cfg.repulsion_gain, cfg.k,
+    grad_rep = repulsive_gradient(kind, p, obstacles, cfg.repulsion_gain, cfg.k,
                                   nearest_only=cfg.repulsion_mode == 'nearest',
                                   influence=cfg.influence_distance)
     if field is not None:

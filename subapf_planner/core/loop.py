@@ -18,6 +18,7 @@ from __future__ import annotations
 
 from collections import deque
 from dataclasses import dataclass
+import math
 
 import numpy as np
 
@@ -188,8 +189,14 @@ class DecisionLoop:
     def pose_at(self, stamp: float) -> np.ndarray:
         """Odometry pose nearest ``stamp`` (within POSE_MATCH; the newest on a tie),
         else the newest."""
-        t, pose = min(reversed(self.poses), key=lambda tp: abs(tp[0] - stamp))
-        return pose if abs(t - stamp) <= POSE_MATCH else self.pose
+        best, nearest = math.inf, self.pose
+        for t, pose in reversed(self.poses):   # stamps never fall: nearer, then farther
+            gap = abs(t - stamp)
+            if gap > best:
+                break
+            if gap < best:
+                best, nearest = gap, pose
+        return nearest if best <= POSE_MATCH else self.pose
 
     def _set(self, state: State, reason: str) -> None:
         self.state, self.reason = state, reason

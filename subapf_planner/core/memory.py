@@ -33,7 +33,7 @@ from .config import PlannerConfig
 from .navigation import NavigationField, compute_field
 from .occupancy import OccupancyGrid
 from .robot import compose, to_parent
-from .scan import Scan, scan_to_points
+from .scan import Scan
 from .tracking import clusters
 
 #: Goals closer than this are the same goal (the field's, the controller's) [m].
@@ -171,15 +171,15 @@ class NavigationMemory:
                          transient)
         return True
 
-    def align(self, scan: Scan, predicted: ArrayLike,
+    def align(self, base: ArrayLike, predicted: ArrayLike,
               moving: tuple[NDArray, NDArray] | None = None) -> Match:
-        """Match ``scan`` (its geometry checked) to the map: the pose of base_footprint
+        """Match a scan's returns ``base`` (m, 2) in base_footprint [m] (scan_to_points
+        at the identity, in beam order) to the map: the pose of base_footprint
         (core/alignment.py) from the ``predicted`` one (x, y, yaw) in the map's frame.
         ``moving``: discs (centres (k, 2), radii (k,) [m]) whose returns, and
         MOVING_MARGIN around them, take no part. The distance field is reused for
         DISTANCE_FIELD_SCANS scans while it covers the scan."""
-        base = scan_to_points(scan, (0.0, 0.0, 0.0), self.cfg.laser_mount,
-                              self.cfg.obstacle_range)
+        base = np.asarray(base, float).reshape(-1, 2)
         pred = np.asarray(predicted, float)
         here = to_parent(pred, base)
         if moving is not None and len(moving[0]) and len(base):

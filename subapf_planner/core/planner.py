@@ -73,6 +73,24 @@ ARRIVAL_PROGRESS = 0.002
 
 
 @dataclass(frozen=True)
+class Perception:
+    """A cycle's scan waiting to go into the memory once the command is out
+    (Planner.perceive)."""
+
+    scan: Scan
+    #: Its returns (m, 2) in base_footprint [m], in beam order.
+    base: NDArray[np.float64]
+    #: base_footprint's odom pose (x, y, yaw) when it was taken.
+    scan_pose: NDArray[np.float64]
+    #: The goal (x, y) in the memory's frame [m] (the window follows it).
+    goal: NDArray[np.float64]
+    #: Per beam: whether it returned from something moving (None: no tracker).
+    transient: NDArray[np.bool_] | None
+    #: Where what moves was in the last scans (k, 2) [m]: cleared in the memory.
+    trail: NDArray[np.float64]
+
+
+@dataclass(frozen=True)
 class PlanResult:
     """Command and what led to it (points in the odom frame, metres)."""
 
@@ -97,9 +115,9 @@ class PlanResult:
 def input_status(pose: ArrayLike, goal: ArrayLike) -> Status | None:
     """Gate on the inputs: ``invalid_pose`` for a pose that is not three finite numbers
     (x, y, yaw), ``invalid_goal`` for a goal that is not two; None when both are fine."""
-    if np.shape(pose) != (3,) or not np.all(np.isfinite(pose)):
+    if np.shape(pose) != (3,) or not all(math.isfinite(v) for v in pose):
         return Status.INVALID_POSE
-    if np.shape(goal) != (2,) or not np.all(np.isfinite(goal)):
+    if np.shape(goal) != (2,) or not all(math.isfinite(v) for v in goal):
         return Status.INVALID_GOAL
     return None
 
@@ -213,9 +231,8 @@ class Planner:
         self.tracker = _tracker(cfg)
         self._escape: Escape | None = None   # the escape of the last cycle, if it evaded
         self._approach: tuple[NDArray, float] | None = None   # last cycle's goal, distance
-        #: The last cycle's scan for the memory (perceive): scan, odom pose of the scan,
-        #: goal (memory's frame), per beam transient, trail of what moved.
-        self._perception: tuple | None = None
+        #: The last cycle's scan, for the memory (perceive).
+        self._perception: Perception | None = None
         self._clear_alignment()
 
     @property
@@ -280,12 +297,14 @@ class Planner:
         try:   # perceive: the returns placed with the correction of the last scan
             pose, scan_pose = self.in_map(pose), self.in_map(scan_pose)
             goal = goal if goal_in_map else self._anchored(goal)
-            points = scan_to_points(scan, scan_pose, cfg.laser_mount, cfg.obstacle_range)
+            base = scan_to_points(scan, (0.0, 0.0, 0.0), cfg.laser_mount, cfg.obstacle_range)
         except ScanError:
             return self._stop(PlanResult(Command(0.0, 0.0, Status.INVALID_SCAN)))
+        points = to_parent(scan_pose, base)   # the returns in base_footprint, then placed
         tracks, transient = self._track(scan, points, now)
         if cfg.geodesic:   # the memory takes the scan in once the command is out
-            self._perception = (scan, odom_scan_pose, goal, transient, tracks.trail)
+            self._perception = Perception(scan, base, odom_scan_pose, goal, transient,
+                                          tracks.trail)
         seen = _situation(pose, goal, points)
         status = goal_status(cfg, seen['goal_distance'], goal, seen['obstacles'])
         if status is None and cfg.geodesic and cfg.scan_alignment and self._mapping():
@@ -337,13 +356,12 @@ class Planner:
         called, the next step calls it first: the same memory either way."""
         if self._perception is None:
             return
-        scan, scan_pose, goal, transient, trail = self._perception
-        self._perception = None
+        seen, self._perception = self._perception, None
         if self.cfg.scan_alignment:
-            self._align(scan, scan_pose)
-        if len(trail):
-            self.memory.clear(trail)
-        self.memory.integrate(scan, self.in_map(scan_pose), goal, transient)
+            self._align(seen.scan, seen.base, seen.scan_pose)
+        if len(seen.trail):
+            self.memory.clear(seen.trail)
+        self.memory.integrate(seen.scan, self.in_map(seen.scan_pose), seen.goal, seen.transient)
 
     def _mapping(self) -> bool:
         """Whether this cycle stands for the first walls (FIRST_SCANS, the cycle's own
@@ -386,15 +404,16 @@ class Planner:
         alignment; odom itself without it)."""
         return np.array(compose(self.correction, pose))
 
-    def _align(self, scan: Scan, scan_pose: NDArray) -> None:
-        """Match a new scan (not one already matched: same stamp) to the memory and
-        update the correction when the match is accepted, by no more than odometry can
-        have drifted since the last scan (core/alignment.py: within_drift)."""
+    def _align(self, scan: Scan, base: NDArray, scan_pose: NDArray) -> None:
+        """Match a new scan (not one already matched: same stamp), its returns ``base``
+        (m, 2) in base_footprint, to the memory and update the correction when the
+        match is accepted, by no more than odometry can have drifted since the last
+        scan (core/alignment.py: within_drift)."""
         if scan.stamp == self._aligned_stamp:
             return
         self._aligned_stamp = scan.stamp
         predicted = self.in_map(scan_pose)
-        self.match = self.memory.align(scan, predicted, self._moving_discs(scan.stamp))
+        self.match = self.memory.align(base, predicted, self._moving_discs(scan.stamp))
         last, self._aligned_from = self._aligned_from, scan_pose
         if not self.match.accepted or last is None:
             return

@@ -113,21 +113,49 @@ def repulsive_field(kind: str, points: ArrayLike, obstacles: ArrayLike, gain: fl
     obstacle point counts (eq. 7); otherwise the contributions add (eq. 9-10).
     Returns (values (n,), gradients (n, 2)).
     """
+    pairs = _pairs(points, obstacles, nearest_only)
+    if pairs is None:
+        n = np.atleast_2d(np.asarray(points, float)).shape[0]
+        return np.zeros(n), np.zeros((n, 2))
+    diff, dist = pairs
+    active = dist <= influence
+    safe = np.maximum(dist, MIN_DISTANCE)
+    value = np.where(active, repulsive_value(kind, safe, gain, k), 0.0)
+    return value.sum(axis=1), _gradient(kind, diff, safe, active, gain, k)
+
+
+def repulsive_gradient(kind: str, points: ArrayLike, obstacles: ArrayLike, gain: float,
+                       k: float, *, nearest_only: bool = False,
+                       influence: float = math.inf) -> NDArray[np.float64]:
+    """The gradient (n, 2) of :func:`repulsive_field`, the same numbers, without its
+    values (what the APF step needs)."""
+    pairs = _pairs(points, obstacles, nearest_only)
+    if pairs is None:
+        return np.zeros((np.atleast_2d(np.asarray(points, float)).shape[0], 2))
+    diff, dist = pairs
+    return _gradient(kind, diff, np.maximum(dist, MIN_DISTANCE), dist <= influence, gain, k)
+
+
+def _pairs(points: ArrayLike, obstacles: ArrayLike,
+           nearest_only: bool) -> tuple[NDArray, NDArray] | None:
+    """Offsets (n, m, 2) from each obstacle point to each point and their lengths (n, m)
+    [m] (m = 1: the nearest only); None without obstacles."""
     p = np.atleast_2d(np.asarray(points, float))
     obs = np.asarray(obstacles, float).reshape(-1, 2)
-    n = p.shape[0]
     if obs.shape[0] == 0:
-        return np.zeros(n), np.zeros((n, 2))
+        return None
     diff = p[:, None, :] - obs[None, :, :]
     dist = np.hypot(diff[..., 0], diff[..., 1])
     if nearest_only:
         idx = np.argmin(dist, axis=1)
-        rows = np.arange(n)
+        rows = np.arange(p.shape[0])
         diff = diff[rows, idx][:, None, :]
         dist = dist[rows, idx][:, None]
-    active = dist <= influence
-    safe = np.maximum(dist, MIN_DISTANCE)
-    value = np.where(active, repulsive_value(kind, safe, gain, k), 0.0)
+    return diff, dist
+
+
+def _gradient(kind: str, diff: NDArray, safe: NDArray, active: NDArray, gain: float,
+              k: float) -> NDArray[np.float64]:
+    """Sum over the obstacle points of phi'(r) * offset / r, inactive ones left out."""
     slope = np.where(active, repulsive_dr(kind, safe, gain, k), 0.0)
-    grad = (slope / safe)[..., None] * diff
-    return value.sum(axis=1), grad.sum(axis=1)
+    return ((slope / safe)[..., None] * diff).sum(axis=1)
