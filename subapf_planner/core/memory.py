@@ -21,6 +21,7 @@ anything but that idle time).
 from __future__ import annotations
 
 from concurrent.futures import Future, ThreadPoolExecutor
+from dataclasses import dataclass
 import math
 import time
 import weakref
@@ -57,6 +58,23 @@ def _grid(cfg: PlannerConfig) -> OccupancyGrid:
     return OccupancyGrid(*_grid_settings(cfg))
 
 
+@dataclass(frozen=True)
+class FieldJob:
+    """A navigation field to march between cycles: compute_field's inputs as a cycle
+    took them, and what the field is installed as."""
+
+    #: The window's occupied cells and avoided places then (h, w).
+    blocked: NDArray[np.bool_]
+    #: The window's corner then (x, y) [m].
+    origin: NDArray[np.float64]
+    goal: NDArray[np.float64]
+    position: NDArray[np.float64]
+    #: (goal cell, map version) the field is for (NavigationMemory._key).
+    key: tuple
+    #: When the cycle took the map [s].
+    time: float
+
+
 class NavigationMemory:
     """Occupancy grid + navigation field for one robot. Not thread-safe."""
 
@@ -76,11 +94,10 @@ class NavigationMemory:
         self._distance_age = 0
         #: Places tried and not passed: (x, y, radius [m], until [s]) (see ``avoid``).
         self.avoided: list[tuple[float, float, float, float]] = []
-        #: A field to march between cycles: its inputs, taken in the cycle, with its
-        #: (key, time) (start_marching starts it) ...
-        self._due: tuple[tuple, tuple, float] | None = None
-        #: ... and once started, the field being marched in the worker.
-        self._pending: tuple[Future, tuple, float] | None = None
+        #: A field to march between cycles (start_marching starts it) ...
+        self._due: FieldJob | None = None
+        #: ... and once started, the field being marched in the worker, and its job.
+        self._pending: tuple[Future, FieldJob] | None = None
         self._worker: ThreadPoolExecutor | None = None
 
     def reconfigure(self, cfg: PlannerConfig) -> None:
@@ -114,14 +131,14 @@ class NavigationMemory:
         thread. For after the cycle's command is out: the marching holds the GIL
         (scikit-fmm does not release it), so started within the cycle it would hold up
         the rest of it. Not called, the next call marches it itself (the same field)."""
-        if self._due is None:
+        job, self._due = self._due, None
+        if job is None:
             return
-        args, key, now = self._due
-        self._due = None
         if self._worker is None:
             self._worker = ThreadPoolExecutor(max_workers=1, thread_name_prefix='field')
             weakref.finalize(self, self._worker.shutdown, wait=False)
-        self._pending = (self._worker.submit(self._compute, *args), key, now)
+        self._pending = (self._worker.submit(self._compute, job.blocked, job.origin, job.goal,
+                                             job.position), job)
 
     def settle(self) -> None:
         """Start the field due and wait until it is done; the next call takes it as it
@@ -134,8 +151,8 @@ class NavigationMemory:
     def _march_later(self, goal: NDArray, position: NDArray, now: float) -> None:
         """Take the map as it is now for a field to march between cycles
         (start_marching); the next call takes that field."""
-        self._due = ((self._blocked(now), self.grid.origin.copy(), goal, position),
-                     self._key(goal), now)
+        self._due = FieldJob(self._blocked(now), self.grid.origin.copy(), goal, position,
+                             self._key(goal), now)
 
     def _compute(self, blocked: NDArray[np.bool_], origin: NDArray, goal: NDArray,
                  position: NDArray) -> tuple[NavigationField | None, float]:
@@ -265,9 +282,8 @@ class NavigationMemory:
         self.recomputed = False
         self.start_marching()   # (if nobody did since the last call)
         if self._pending is not None:   # the field marched since the last call
-            job, key, started = self._pending
-            self._pending = None
-            self._install(job.result(), key, started)
+            (marching, job), self._pending = self._pending, None
+            self._install(marching.result(), job.key, job.time)
         if now is not None and any(now >= a[3] for a in self.avoided):
             self._field_key = None   # an avoided place opens again
         key = self._key(g)
