@@ -122,3 +122,11 @@ def test_a_cluster_that_is_not_there_is_a_clear_error(tmp_path, capsys, worlds_d
     rc = main([str(worlds_dir / 'four_points.yaml'), '--cluster', 'tcp://127.0.0.1:9',
                '--out', str(tmp_path / 'x'), '--no-plots'])
     assert rc == 2 and 'cluster tcp://127.0.0.1:9' in capsys.readouterr().err
+
+
+def test_nodeperf_times_the_nodes_loop_in_process():
+    """subapf-nodeperf's in-process figure: the decision loop on the node's inputs, a
+    cycle timed back to back and after an idle period (a figure, not a target)."""
+    from subapf_planner.tools.nodeperf import loop_cycle_ms
+    warm, idle = loop_cycle_ms(cycles=3), loop_cycle_ms(cycles=3, idle=0.01)
+    assert 0.0 < warm < 1e3 and 0.0 < idle < 1e3

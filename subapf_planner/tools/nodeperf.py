@@ -6,7 +6,13 @@
    stamped with its planning tick, so this is planning + publish + DDS),
    median and p99; planner CPU per cycle (process CPU time / cycles, from
    /proc); resident memory (VmRSS) at start and end.
-2. sim_node at ``rate`` 100 (as fast as it goes): real-time factor
+2. The same decision loop in this process on the same inputs, no DDS: its work per
+   cycle (tick and the work after the command) back to back, and with the node's idle
+   period between cycles. The node works in a burst every 0.2 s; on this machine such
+   a burst runs about three times slower than the same work repeated at once (warm
+   caches and predictors; the ratio is the machine's, not the code's), which is most
+   of the node's CPU per cycle: the ratio tells what the machine adds.
+3. sim_node at ``rate`` 100 (as fast as it goes): real-time factor
    (simulated seconds per wall second, first /clock to the time-limit outcome), and the in-process
    simulator's real-time factor with the planner in the loop (episode.py).
 """
@@ -116,6 +122,37 @@ def planner_figures(seconds: float, domain: int, watched: bool = False) -> dict[
             'rss_mib_end': rss1, 'views': views}
 
 
+def loop_cycle_ms(cycles: int = 50, idle: float = 0.0) -> float:
+    """Median wall time [ms] of the decision loop's cycle (tick, then after_tick) on
+    planner_figures' inputs (a scan every cycle, odometry four times a cycle, the same
+    goal), in this process, with ``idle`` [s] of sleep between cycles (the node's: its
+    period); the first ten cycles (the memory filling) not counted."""
+    from ..core.config import load_config
+    from ..core.loop import DecisionLoop, Supervision
+    from ..sim.simulator import BurgerSim, SimConfig
+    from ..sim.world import load_world
+
+    world = load_world(shipped_worlds_dir() / 'cluttered_field.yaml')
+    with BurgerSim(world, SimConfig(range_noise=0.01)) as sim:
+        scan = sim.scan()
+        pose = sim.odometry()[0]
+    loop = DecisionLoop(load_config(default_params_file()), Supervision(progress_timeout=600.0))
+    loop.set_goal(np.array([50.0, 50.0]))
+    period = loop.cfg.period
+    times = []
+    for i in range(cycles + 10):
+        now = 100.0 + i * period
+        for k in range(4):
+            loop.update_odom(now + k * period / 4, pose, now + k * period / 4)
+        loop.update_scan(replace(scan, stamp=now + period / 2), now + period / 2)
+        time.sleep(idle)
+        t0 = time.perf_counter()
+        loop.tick(now + period)
+        loop.after_tick()
+        times.append(time.perf_counter() - t0)
+    return 1e3 * float(np.median(times[10:]))
+
+
 def sim_node_rtf(domain: int) -> float:
     """Simulated seconds per wall second of sim_node at rate 100 with no robot command:
     from the first /clock seen to the 'timeout' outcome at the world's time limit."""
@@ -178,6 +215,10 @@ def main(argv: list[str] | None = None) -> int:
               f'{f["latency_ms_median"]:.2f} ms, p99 {f["latency_ms_p99"]:.2f} ms; '
               f'CPU {f["cpu_ms_per_cycle"]:.2f} ms per cycle; RSS '
               f'{f["rss_mib_start"]:.1f} -> {f["rss_mib_end"]:.1f} MiB')
+    warm, idle = loop_cycle_ms(), loop_cycle_ms(idle=0.2)
+    print(f'decision loop in-process on the same inputs: {warm:.2f} ms a cycle back to back, '
+          f'{idle:.2f} ms with 0.2 s idle between cycles as in the node ({idle / warm:.1f}x: '
+          "this machine's cost of working in bursts)")
     print(f'sim_node fast mode (rate 100): real-time factor {sim_node_rtf(domain):.1f}x')
     print(f'in-process simulator + planner (fig6d): real-time factor {episode_rtf():.1f}x')
     return 0
