@@ -289,3 +289,22 @@ def test_a_thinned_polyline_keeps_its_ends_and_its_spacing():
     thin = thin_polyline(zigzag, 0.25)
     assert np.all(np.hypot(*np.diff(thin[:-1], axis=0).T) >= 0.25 - 1e-9)
     np.testing.assert_allclose(thin[[0, -1]], zigzag[[0, -1]])
+
+
+@given(stamps=st.lists(st.integers(0, 40), min_size=1, max_size=30),
+       asked=st.integers(-10, 50))
+@settings(max_examples=200, deadline=None)
+def test_a_scan_is_placed_at_the_odometry_nearest_its_stamp(stamps, asked):
+    """DecisionLoop.pose_at: of the odometry kept (stamps never falling, repeats
+    allowed), the pose nearest the scan's stamp, the newest of equally near ones;
+    none within POSE_MATCH: the newest pose."""
+    from subapf_planner.core.loop import POSE_MATCH, DecisionLoop
+    loop = DecisionLoop(PlannerConfig())
+    times = np.sort(np.asarray(stamps)) * 0.05
+    for i, t in enumerate(times):
+        assert loop.update_odom(float(t), np.array([float(i), 0.0, 0.0]), float(t))
+    stamp = asked * 0.05
+    gaps = np.abs(times - stamp)
+    newest_nearest = len(times) - 1 - int(np.argmin(gaps[::-1]))
+    expected = newest_nearest if gaps[newest_nearest] <= POSE_MATCH else len(times) - 1
+    assert loop.pose_at(stamp)[0] == expected

@@ -10,7 +10,7 @@ from rcl_interfaces.msg import ParameterDescriptor
 import rclpy
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.parameter import Parameter
-from rclpy.qos import qos_profile_sensor_data
+from rclpy.qos import QoSProfile, qos_profile_sensor_data
 from sensor_msgs.msg import LaserScan
 from std_msgs.msg import String
 
@@ -298,21 +298,60 @@ def test_scans_and_odometry_are_taken_at_the_tick_not_by_the_executor(harness):
 
 
 def test_a_publisher_the_polled_inputs_cannot_hear_is_reported(harness, capfd):
-    """Odometry is polled at the tick (PolledGroup), but the subscription's QoS events
-    still run: a best-effort odometry publisher, which a reliable subscription never
-    hears, gets the node's warning (rclpy's default handler) instead of silence."""
+    """Odometry is polled at the tick (PolledGroup), so rclpy's QoS-event warning never
+    runs for it; while odometry is silent the node looks at its publishers itself: a
+    best-effort one, which the reliable subscription never hears, is named, once."""
     h = harness()
     quiet = h.peer.create_publisher(Odometry, 'odom', qos_profile_sensor_data)
-    odom = next(sub for sub, _ in h.node._inputs if sub.topic_name == '/odom')
-    handlers = odom.event_handlers
-    assert handlers and all(odom.callback_group.can_execute(e) for e in handlers)
-    assert not odom.callback_group.can_execute(odom)
-    warning = "New publisher discovered on topic 'odom', offering incompatible QoS"
+    warning = "/odom: the QoS /peer offers is incompatible with this node's"
     seen = []
     assert h.spin_until(lambda: (seen.append(capfd.readouterr().err), warning in seen[-1])[1])
     quiet.publish(Odometry())
-    h.spin_until(lambda: False, timeout=0.5)   # two planning ticks: nothing came
-    assert h.node.ctl.pose is None
+    h.spin_until(lambda: (seen.append(capfd.readouterr().err), False)[1], timeout=4.5)
+    assert h.node.ctl.pose is None   # nothing came
+    assert sum(text.count(warning) for text in seen) == 1   # said once
+
+
+def test_unheard_publishers_are_those_of_another_type_or_an_incompatible_qos():
+    """ros/qos.py unheard_by, from endpoint infos built directly: a reliable odometry
+    subscription hears reliable publishers only, a best-effort one hears both; a
+    publisher of another type is named with both types."""
+    from rclpy.qos import ReliabilityPolicy
+    from rclpy.topic_endpoint_info import TopicEndpointInfo
+
+    from subapf_planner.ros.qos import type_name, unheard_by
+
+    def info(gid, kind='nav_msgs/msg/Odometry', qos=QoSProfile(depth=10)):
+        return TopicEndpointInfo(node_name=f'driver{gid}', node_namespace='/robot',
+                                 topic_type=kind, endpoint_gid=[gid] * 16, qos_profile=qos)
+    best_effort = QoSProfile(depth=5, reliability=ReliabilityPolicy.BEST_EFFORT)
+    assert type_name(Odometry) == 'nav_msgs/msg/Odometry'
+    publishers = [info(1), info(2, qos=best_effort), info(3, 'nav_msgs/msg/Path')]
+    found = unheard_by('/odom', Odometry, QoSProfile(depth=50), publishers)
+    assert set(found) == {bytes([2] * 16), bytes([3] * 16)}
+    assert found[bytes([2] * 16)].startswith('/odom: the QoS /robot/driver2 offers')
+    assert 'reliab' in found[bytes([2] * 16)].lower()
+    assert 'nav_msgs/msg/Path' in found[bytes([3] * 16)]
+    assert unheard_by('/scan', Odometry, best_effort, publishers[:2]) == {}
+
+
+def test_the_executor_sleeps_while_polled_messages_wait(harness):
+    """Messages waiting in the polled subscriptions do not wake the executor: nothing
+    of the inputs (their QoS events included: with Fast DDS they would wake it while a
+    message is unread) is in its wait set, so between ticks the process rests."""
+    import time
+    h = harness(planning_frequency=0.5)
+    polled = [sub for sub, _ in h.node._inputs]
+    entities = [e for sub in polled for e in (sub, *sub.event_handlers)]
+    assert not any(e.callback_group.can_execute(e) for e in entities)
+    h.wait_matched()
+    ex = SingleThreadedExecutor(context=h.node.context)
+    ex.add_node(h.node)   # the planner alone: the peer's own wake-ups not counted
+    cpu, end = time.process_time(), time.monotonic() + 1.5
+    while time.monotonic() < end:   # scans and odometry keep coming, 0.5 Hz ticks
+        h.feed()
+        ex.spin_once(timeout_sec=0.1)
+    assert time.process_time() - cpu < 0.5   # a spinning executor takes the whole 1.5 s
 
 
 def test_spin_node_bad_input_only_while_building_bugs_keep_their_traceback():

@@ -14,7 +14,9 @@ Topics (relative, so namespaces and remapping work):
        sent only while something subscribes
 
 Scans and odometry are taken at the planning tick (ros/spinning.PolledGroup), so
-only the timer (and goals, parameters, /clock, QoS events) wakes the process.
+only the timer (and goals, parameters, /clock) wakes the process. While one of them
+is silent past its timeout, the node looks at its publishers and warns, once each,
+about those it cannot hear (another message type, an incompatible QoS).
 
 The node only translates messages and parameters and drives one timer; the
 decisions are subapf_planner.core.loop's, the input checks ros/intake.py's.
@@ -49,7 +51,7 @@ from .conversions import cmd_to_msg, grid_to_msg, path_to_msg, planar_transform,
 from .intake import Intake
 from .markers import markers_from_result
 from .parameters import declare, read
-from .qos import LATCHED, listened
+from .qos import LATCHED, listened, unheard_publishers
 from .spinning import PolledGroup, spin_node
 
 NODE_NAME = 'subapf_planner'
@@ -60,6 +62,9 @@ CLOCK_JUMP = 1.0
 PLAN_SPACING = 0.25
 #: Longest time between two ~/plan messages while the field is used [s].
 PLAN_PERIOD = 1.0
+#: While scan or odometry is silent past its timeout, its publishers are looked at this
+#: often, for one this node cannot hear [s].
+SILENCE_CHECK = 2.0
 #: Odometry queued between two ticks (taken at the tick, not on arrival): 2.5 s at 20 Hz,
 #: 10 planning periods of the default.
 ODOM_QUEUE = 50
@@ -140,6 +145,8 @@ class PlannerNode(Node):
                                       QoSProfile(depth=ODOM_QUEUE), callback_group=polled),
              self._on_odom))
         self.create_subscription(PoseStamped, 'goal_pose', self._on_goal, 10)
+        self._silence_checked = -float('inf')   # when the silent inputs were looked at
+        self._unheard: set[bytes] = set()   # publishers warned about (endpoint GIDs)
 
         #: /tf_static so far: child -> (parent, planar pose, level); the mounting read
         #: from it (None: the parameters').
@@ -279,9 +286,30 @@ class PlannerNode(Node):
                         later.append((handler, msg))
         return later
 
+    def _explain_silence(self, now: float) -> None:
+        """Warn, once per publisher, about each publisher of a silent input (scan or
+        odometry older than its timeout, or none yet) whose messages this node can never
+        receive. rclpy warns of these from a subscription's QoS events, which the
+        executor does not wait on for the polled inputs (ros/spinning.PolledGroup)."""
+        if 0.0 <= now - self._silence_checked < SILENCE_CHECK:
+            return
+        self._silence_checked = now
+        lim, ctl = self.ctl.limits, self.ctl
+        (scan_sub, _), (odom_sub, _) = self._inputs
+        for sub, last, timeout in ((scan_sub, ctl.scan_time, lim.scan_timeout),
+                                   (odom_sub, ctl.odom_time, lim.odom_timeout)):
+            if last is not None and now - last <= timeout:
+                continue
+            found = unheard_publishers(sub, self.get_publishers_info_by_topic(sub.topic_name))
+            for gid, problem in found.items():
+                if gid not in self._unheard:
+                    self._unheard.add(gid)
+                    self.get_logger().warn(problem)
+
     def _on_timer(self) -> None:
         tick = self.get_clock().now()
         later = self._take_arrived_inputs(tick.nanoseconds)
+        self._explain_silence(tick.nanoseconds * 1e-9)
         decision = self.ctl.tick(tick.nanoseconds * 1e-9)
         for handler, msg in later:
             handler(msg)
