@@ -9,9 +9,10 @@
 2. The same decision loop in this process on the same inputs, no DDS: its work per
    cycle (tick and the work after the command) back to back, and with the node's idle
    period between cycles. The node works in a burst every 0.2 s; on this machine such
-   a burst runs about three times slower than the same work repeated at once (warm
-   caches and predictors; the ratio is the machine's, not the code's), which is most
-   of the node's CPU per cycle: the ratio tells what the machine adds.
+   a burst runs two to three times slower than the same work repeated at once (likely
+   caches and predictors gone cold while it sleeps: the ratio is the machine's, not
+   the code's), which is most of the gap between the loop's figures and the node's
+   CPU per cycle.
 3. sim_node at ``rate`` 100 (as fast as it goes): real-time factor
    (simulated seconds per wall second, first /clock to the time-limit outcome), and the in-process
    simulator's real-time factor with the planner in the loop (episode.py).
@@ -47,6 +48,17 @@ VIEWS = (('markers', 'visualization_msgs.msg', 'MarkerArray'),
          ('status', 'std_msgs.msg', 'String'))
 
 
+def node_inputs() -> tuple:
+    """The scan and odometry pose the measurements feed: the simulator's, standing in
+    the shipped cluttered_field world (1 cm range noise)."""
+    from ..sim.simulator import BurgerSim, SimConfig
+    from ..sim.world import load_world
+
+    world = load_world(shipped_worlds_dir() / 'cluttered_field.yaml')
+    with BurgerSim(world, SimConfig(range_noise=0.01)) as sim:
+        return sim.scan(), sim.odometry()[0]
+
+
 def planner_figures(seconds: float, domain: int, watched: bool = False) -> dict[str, float]:
     """The planner node's figures; ``watched``: with a subscriber on each of VIEWS (the
     visualisation is built and sent only then)."""
@@ -60,13 +72,8 @@ def planner_figures(seconds: float, domain: int, watched: bool = False) -> dict[
 
     from ..ros.conversions import odom_to_msg, scan_to_msg
     from ..ros.qos import LATCHED
-    from ..sim.simulator import BurgerSim, SimConfig
-    from ..sim.world import load_world
 
-    world = load_world(shipped_worlds_dir() / 'cluttered_field.yaml')
-    with BurgerSim(world, SimConfig(range_noise=0.01)) as sim:
-        scan = sim.scan()
-        pose = sim.odometry()[0]
+    scan, pose = node_inputs()
     env = join_domain(domain)
     child = start('planner_node', ['--params-file', str(default_params_file()),
                                    '-p', 'progress_timeout:=600.0'], env, quiet=True)
@@ -129,13 +136,8 @@ def loop_cycle_ms(cycles: int = 50, idle: float = 0.0) -> float:
     period); the first ten cycles (the memory filling) not counted."""
     from ..core.config import load_config
     from ..core.loop import DecisionLoop, Supervision
-    from ..sim.simulator import BurgerSim, SimConfig
-    from ..sim.world import load_world
 
-    world = load_world(shipped_worlds_dir() / 'cluttered_field.yaml')
-    with BurgerSim(world, SimConfig(range_noise=0.01)) as sim:
-        scan = sim.scan()
-        pose = sim.odometry()[0]
+    scan, pose = node_inputs()
     loop = DecisionLoop(load_config(default_params_file()), Supervision(progress_timeout=600.0))
     loop.set_goal(np.array([50.0, 50.0]))
     period = loop.cfg.period
