@@ -313,13 +313,13 @@ def test_a_publisher_the_polled_inputs_cannot_hear_is_reported(harness, capfd):
 
 
 def test_unheard_publishers_are_those_of_another_type_or_an_incompatible_qos():
-    """ros/qos.py unheard_by, from endpoint infos built directly: a reliable odometry
-    subscription hears reliable publishers only, a best-effort one hears both; a
+    """ros/qos.py unheard_publishers, from endpoint infos built directly: a reliable
+    odometry subscription hears reliable publishers only, a best-effort one hears both; a
     publisher of another type is named with both types."""
     from rclpy.qos import ReliabilityPolicy
     from rclpy.topic_endpoint_info import TopicEndpointInfo
 
-    from subapf_planner.ros.qos import type_name, unheard_by
+    from subapf_planner.ros.qos import type_name, unheard_publishers
 
     def info(gid, kind='nav_msgs/msg/Odometry', qos=QoSProfile(depth=10)):
         return TopicEndpointInfo(node_name=f'driver{gid}', node_namespace='/robot',
@@ -327,12 +327,12 @@ def test_unheard_publishers_are_those_of_another_type_or_an_incompatible_qos():
     best_effort = QoSProfile(depth=5, reliability=ReliabilityPolicy.BEST_EFFORT)
     assert type_name(Odometry) == 'nav_msgs/msg/Odometry'
     publishers = [info(1), info(2, qos=best_effort), info(3, 'nav_msgs/msg/Path')]
-    found = unheard_by('/odom', Odometry, QoSProfile(depth=50), publishers)
+    found = unheard_publishers('/odom', Odometry, QoSProfile(depth=50), publishers)
     assert set(found) == {bytes([2] * 16), bytes([3] * 16)}
     assert found[bytes([2] * 16)].startswith('/odom: the QoS /robot/driver2 offers')
     assert 'reliab' in found[bytes([2] * 16)].lower()
     assert 'nav_msgs/msg/Path' in found[bytes([3] * 16)]
-    assert unheard_by('/scan', Odometry, best_effort, publishers[:2]) == {}
+    assert unheard_publishers('/scan', Odometry, best_effort, publishers[:2]) == {}
 
 
 def test_the_executor_sleeps_while_polled_messages_wait(harness):

@@ -206,6 +206,13 @@ class DecisionLoop:
         self._set(state, reason)
         return Decision(command, state, reason, result)
 
+    def silent(self, now: float) -> tuple[bool, bool]:
+        """Whether the scan, and the odometry, are silent at ``now`` [s]: none taken
+        yet, or the newest older than scan_timeout (odom_timeout)."""
+        lim = self.limits
+        return (self.scan_time is None or now - self.scan_time > lim.scan_timeout,
+                self.odom_time is None or now - self.odom_time > lim.odom_timeout)
+
     def _stop(self, state: State, reason: str, result: PlanResult | None = None) -> Decision:
         self.planner.reset()
         return self._decide((0.0, 0.0), state, reason, result)
@@ -218,9 +225,10 @@ class DecisionLoop:
         if self.scan is None or self.pose is None:
             return self._decide(None, State.WAITING,
                                 f'no {"scan" if self.scan is None else "odom"} yet')
-        if now - self.scan_time > lim.scan_timeout:
+        scan_silent, odom_silent = self.silent(now)
+        if scan_silent:
             return self._stop(State.STOPPED, 'scan is stale')
-        if now - self.odom_time > lim.odom_timeout:
+        if odom_silent:
             return self._stop(State.STOPPED, 'odometry is stale')
         if self.state.gave_up:
             return Decision((0.0, 0.0), self.state, self.reason)

@@ -294,13 +294,11 @@ class PlannerNode(Node):
         if 0.0 <= now - self._silence_checked < SILENCE_CHECK:
             return
         self._silence_checked = now
-        lim, ctl = self.ctl.limits, self.ctl
-        (scan_sub, _), (odom_sub, _) = self._inputs
-        for sub, last, timeout in ((scan_sub, ctl.scan_time, lim.scan_timeout),
-                                   (odom_sub, ctl.odom_time, lim.odom_timeout)):
-            if last is not None and now - last <= timeout:
+        for (sub, _), silent in zip(self._inputs, self.ctl.silent(now), strict=True):
+            if not silent:
                 continue
-            found = unheard_publishers(sub, self.get_publishers_info_by_topic(sub.topic_name))
+            found = unheard_publishers(sub.topic_name, sub.msg_type, sub.qos_profile,
+                                       self.get_publishers_info_by_topic(sub.topic_name))
             for gid, problem in found.items():
                 if gid not in self._unheard:
                     self._unheard.add(gid)

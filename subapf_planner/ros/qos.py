@@ -4,7 +4,6 @@ hear."""
 
 from rclpy.publisher import Publisher
 from rclpy.qos import DurabilityPolicy, QoSCompatibility, QoSProfile, qos_check_compatible
-from rclpy.subscription import Subscription
 from rclpy.topic_endpoint_info import TopicEndpointInfo
 
 #: Published once, kept for late joiners (outcome, map, /tf_static).
@@ -21,18 +20,12 @@ def type_name(msg_type: type) -> str:
     return f'{msg_type.__module__.split(".")[0]}/msg/{msg_type.__name__}'
 
 
-def unheard_publishers(sub: Subscription,
+def unheard_publishers(topic: str, msg_type: type, qos: QoSProfile,
                        publishers: list[TopicEndpointInfo]) -> dict[bytes, str]:
-    """Of the ``publishers`` of ``sub``'s topic (Node.get_publishers_info_by_topic), those
-    whose messages ``sub`` can never receive, by endpoint GID: why, one line each (a
-    message type other than the subscription's, or a QoS the subscription's is
-    incompatible with, e.g. a best-effort publisher and a reliable subscription)."""
-    return unheard_by(sub.topic_name, sub.msg_type, sub.qos_profile, publishers)
-
-
-def unheard_by(topic: str, msg_type: type, qos: QoSProfile,
-               publishers: list[TopicEndpointInfo]) -> dict[bytes, str]:
-    """unheard_publishers for a subscription to ``topic`` of ``msg_type`` with ``qos``."""
+    """Of the ``publishers`` of ``topic`` (Node.get_publishers_info_by_topic), those whose
+    messages a subscription of ``msg_type`` with ``qos`` can never receive, by endpoint
+    GID: why, one line each (another message type, or an incompatible QoS, e.g. a
+    best-effort publisher and a reliable subscription)."""
     wanted = type_name(msg_type)
     unheard = {}
     for pub in publishers:
