@@ -15,6 +15,8 @@ EXECUTABLES = [
     ('ros.foxglove_node:main', 'foxglove_node', 'subapf-foxglove'),
     ('tools.bringup:main', 'bringup', 'subapf-bringup'),
     ('tools.bench:main', 'bench', 'subapf-bench'),
+    ('tools.results:main', 'results', 'subapf-results'),
+    ('tools.fingerprint:main', 'fingerprint', 'subapf-fingerprint'),
     ('tools.figures:main', 'figures', 'subapf-figures'),
     ('tools.perf:main', 'perf', 'subapf-perf'),
     ('tools.nodeperf:main', 'nodeperf', 'subapf-nodeperf'),
@@ -67,7 +69,7 @@ if ROS_BUILD:
 
 setup(
     name=PACKAGE,
-    version='0.1.0',
+    version='0.8.0',
     packages=find_packages(exclude=['test']),
     package_data={PACKAGE + '.sim': ['urdf/*.urdf']},
     data_files=[

@@ -1,7 +1,7 @@
 """subapf_planner: local planner with a subharmonic artificial potential field.
 
 Implements Peng, Zhang and Xiong, "Smooth Path Planning with Subharmonic
-Artificial Potential Field", with the corrections of README "Where the paper is
+Artificial Potential Field", with the corrections of docs/design.md "Where the paper is
 wrong". Subpackages (test/test_layers.py enforces who imports whom):
 
 * ``core``: pure numpy/scipy, no ROS: params, config, robot (the robot and its

@@ -21,7 +21,8 @@ import itertools
 import os
 from pathlib import Path
 import tempfile
-from typing import IO
+import time
+from typing import IO, Callable, TypeVar
 import warnings
 
 import pytest
@@ -44,6 +45,7 @@ BRINGUP_DOMAINS = range(1, 102)
 LEASE_DIR = Path(tempfile.gettempdir()) / 'subapf_planner_domains'
 
 _next = itertools.count()
+_T = TypeVar('_T')
 
 
 class DomainLease:
@@ -189,3 +191,32 @@ def with_paths(env: dict[str, str], paths: dict[str, str]) -> dict[str, str]:
     for k, v in paths.items():
         out[k] = os.pathsep.join(filter(None, [v, env.get(k)]))
     return out
+
+
+def wait_for(predicate: Callable[[], _T], timeout: float, what: str | Callable[[], str],
+             interval: float = 0.05) -> _T:
+    """Call ``predicate`` until it returns something true, and return that. After
+    ``timeout`` seconds (monotonic) fail: AssertionError "timed out after T s waiting
+    for WHAT", ``what`` a text or a callable giving one (called then only: a log, say).
+    A predicate that blocks itself (an executor's spin_once) can take ``interval`` 0."""
+    end = time.monotonic() + timeout
+    while True:
+        value = predicate()
+        if value:
+            return value
+        if time.monotonic() >= end:
+            text = what() if callable(what) else what
+            raise AssertionError(f'timed out after {timeout:g} s waiting for {text}')
+        time.sleep(interval)
+
+
+def colour_pixels(png: Path, colour: str, tol: float = 30.0) -> int:
+    """How many pixels of the image ``png`` have the matplotlib ``colour`` (each RGB
+    channel within ``tol`` of it, on 0-255)."""
+    from matplotlib import colors
+    import numpy as np
+    from PIL import Image
+    with Image.open(png) as im:
+        rgb = np.asarray(im.convert('RGB'), float)
+    want = 255 * np.array(colors.to_rgb(colour))
+    return int((np.abs(rgb - want).max(axis=-1) < tol).sum())

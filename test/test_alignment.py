@@ -370,7 +370,7 @@ def test_with_the_alignment_the_robot_stands_until_its_first_walls_are_establish
     """The memory's frame is odom at the start: the first FIRST_SCANS scans are taken
     standing (``mapping``, a stop), so that a first turn's drift is not drawn into the
     walls everything after is matched to. Without the alignment it drives at once."""
-    from subapf_planner.core.planner import FIRST_SCANS
+    from subapf_planner.core.gates import FIRST_SCANS
     from subapf_planner.core.status import Status
     walls = room()
     for aligned in (True, False):

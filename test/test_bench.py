@@ -32,7 +32,7 @@ def test_short_bench_writes_consistent_results(tmp_path, worlds_dir):
     assert doc['methods'] == ['subharmonic_sampling:geodesic', 'dwa:euclidean']
     for r in runs:
         assert KEYS <= set(r)
-        # both planners pass both open worlds (README, shipped-world table), without
+        # both planners pass both open worlds (docs/results.md, the shipped worlds), without
         # touching anything, and the run's record agrees with itself
         assert r['outcome'] == 'reached', r
         assert r['final_distance'] <= r['goal_tolerance']
@@ -57,7 +57,7 @@ def test_bench_rejects_unknown_method_and_bad_world(tmp_path, capsys):
 
 
 # The paper's Fig. 6 claims, asserted where they hold with one parameter set
-# (config/planner.yaml defaults) on the shipped worlds. See README 'Results'.
+# (config/planner.yaml defaults) on the shipped worlds. See docs/results.md.
 @pytest.mark.parametrize('name', ['fig6c_circle_in_front', 'fig6d_big_wall'])
 def test_only_sampling_passes_the_local_minima(worlds_dir, name):
     world = load_world(worlds_dir / f'{name}.yaml')
@@ -83,8 +83,9 @@ def test_every_default_method_is_drawn_its_own_way():
     assert method_style('subharmonic_sampling:euclidean')[1] == '--'
 
 
-#: What results.json may differ in between two runs of the same bench: wall-clock times.
-TIMING = {'wall_time_s', 'plan_ms_median', 'plan_ms_p99'}
+#: What results.json may differ in between two runs of the same bench: wall-clock times
+#: and how it was produced (``meta``: the command line, the date).
+TIMING = {'wall_time_s', 'plan_ms_median', 'plan_ms_p99', 'meta'}
 
 
 def without_timing(doc: dict) -> dict:

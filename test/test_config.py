@@ -15,7 +15,8 @@ def test_yaml_lists_every_core_parameter_with_its_default():
     params = yaml.safe_load(PARAMS.read_text())['subapf_planner']['ros__parameters']
     for f in dataclasses.fields(PlannerConfig):
         assert f.name in params, f'{f.name} missing from config/planner.yaml'
-        assert params[f.name] == f.default, f.name
+        default = list(f.default) if isinstance(f.default, tuple) else f.default
+        assert params[f.name] == default, f.name
     assert load_config(PARAMS) == PlannerConfig()
 
 
@@ -27,6 +28,9 @@ def test_yaml_lists_every_core_parameter_with_its_default():
     ({'method': 'magic'}, "method: 'magic' is not one of"),
     ({'max_linear_velocity': 'fast'}, 'max_linear_velocity: expected a number'),
     ({'use_gpu': True}, 'unknown parameter'),
+    ({'critics': ['progres']}, r"unknown critic 'progres' \(did you mean 'progress'\?\)"),
+    ({'critics': ['no_such_module:Critic']}, "cannot load 'no_such_module:Critic'"),
+    ({'critics': 'progress'}, 'critics: expected a list of strings'),
 ])
 def test_bad_values_name_the_parameter(changes, message):
     with pytest.raises(ConfigError, match=message):
@@ -66,7 +70,8 @@ def test_yaml_lists_every_node_parameter_with_its_default():
         fields = [f for g in groups for f in dataclasses.fields(g)]
         assert set(params) == {f.name for f in fields}
         for f in fields:
-            assert params[f.name] == f.default and type(params[f.name]) is type(f.default), \
+            default = list(f.default) if isinstance(f.default, tuple) else f.default
+            assert params[f.name] == default and type(params[f.name]) is type(default), \
                 f.name
 
 

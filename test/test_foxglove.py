@@ -196,7 +196,7 @@ def test_a_taken_port_is_a_clear_error(ros_env):
 def test_a_client_that_connects_late_still_gets_the_latched_topics(ros_env, tf2_msgs_built,
                                                                     tmp_path):
     """/tf_static is published once (transient local); a Foxglove client that connects
-    after that still gets it, as a late DDS subscriber would."""
+    after the relay got it still gets it, as a late DDS subscriber would."""
     from test_tf import WORLD, wait_for_line
 
     from subapf_planner.ros.processes import start, stop
@@ -206,7 +206,13 @@ def test_a_client_that_connects_late_still_gets_the_latched_topics(ros_env, tf2_
              start('foxglove_node', ['-p', f'port:={port}'], env, log=tmp_path / 'fox.log')]
     try:
         wait_for_line(tmp_path / 'fox.log', 'serving /tf_static')
-        time.sleep(2.0)   # long after the one message went out
+        # once a first client has the one message, the relay has it (it keeps a latched
+        # message before it passes it on): the second client comes after it went out.
+        # (The relay takes it as soon as it sees the topic, so the first is late too.)
+        channels, got = asyncio.run(watch(port, 30.0, nodes[1], wanted=('/tf_static',)))
+        assert got.get('/tf_static'), ('the first client got no /tf_static, neither live '
+                                       "nor the relay's latched copy", sorted(channels),
+                                       (tmp_path / 'fox.log').read_text())
         channels, got = asyncio.run(watch(port, 30.0, nodes[1], wanted=('/tf_static',)))
     finally:
         stop(nodes)

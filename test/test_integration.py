@@ -9,13 +9,14 @@ import subprocess
 import sys
 import time
 
-from conftest import PARAMS, WORLDS, domain_processes
+from conftest import PARAMS, WORLDS, colour_pixels, domain_processes, wait_for
 import numpy as np
 import pytest
 
 from subapf_planner.core.config import PlannerConfig
 from subapf_planner.sim.episode import run_episode
 from subapf_planner.sim.world import load_world
+from subapf_planner.tools.plots import METHOD_STYLE
 
 pytestmark = pytest.mark.dds
 
@@ -35,7 +36,14 @@ def test_bringup_reaches_goal_like_the_in_process_run(tmp_path, world, bringup_e
     result = bringup(tmp_path, world, bringup_env, '--record', str(bag))
     assert result.returncode == 0, result.stdout + result.stderr
     assert 'outcome reached' in result.stdout
-    assert (tmp_path / 'run.png').stat().st_size > 10_000
+    # the plot shows the driven path (the method's colour: > 300 pixels, its legend line
+    # alone has about 50), the obstacles (grey fill) and the start, goal and axes (black)
+    png = tmp_path / 'run.png'
+    drawn = {what: colour_pixels(png, colour) for what, colour in (
+        ('path', METHOD_STYLE['subharmonic_sampling'][0]), ('obstacles', '0.55'),
+        ('markers and axes', 'black'))}
+    assert drawn['path'] > 300 and drawn['obstacles'] > 5000 \
+        and drawn['markers and axes'] > 1000, drawn
     in_process = run_episode(load_world(WORLDS / world), PlannerConfig())
     assert in_process.outcome == 'reached'
     check_bag_with_rosbags(bag)
@@ -91,7 +99,7 @@ def test_bad_world_and_bad_parameters_exit_with_clear_errors(tmp_path, ros_env):
 def test_standalone_recorder_finalises_on_sigint_and_replays(tmp_path, bringup_env):
     """Run with the paper's memoryless method: with the default's occupancy memory a
     replay is exact only when the live node got every scan before its tick, which a
-    loaded machine at 5x does not give (README, "Recording and replay")."""
+    loaded machine at 5x does not give (docs/recording.md)."""
     env = bringup_env
     paper = tmp_path / 'paper.yaml'
     paper.write_text(PARAMS.read_text().replace('attraction_field: geodesic',
@@ -220,21 +228,48 @@ def processes_in_domain(domain: int) -> list[int]:
 @pytest.mark.parametrize('sig', [signal.SIGINT, signal.SIGTERM])
 def test_bringup_interrupted_stops_everything_and_finalises_the_bag(tmp_path, sig,
                                                                    bringup_env):
+    from geometry_msgs.msg import TwistStamped
+    import rclpy
+    from rclpy.executors import SingleThreadedExecutor
     env = bringup_env
     domain = int(env['ROS_DOMAIN_ID'])
     bag = tmp_path / 'cut.mcap'
+    # the run's forward commands, heard as the recorder hears them (reliable, the domain)
+    context = rclpy.Context()
+    rclpy.init(context=context)   # on the test's domain (bringup_env set it)
+    node = rclpy.create_node('cmd_listener', context=context)
+    ex = SingleThreadedExecutor(context=context)
+    ex.add_node(node)
+    forward = []
+    node.create_subscription(TwistStamped, '/cmd_vel', lambda m: forward.append(m)
+                             if m.twist.linear.x > 0.0 else None, 100)
     p = subprocess.Popen([sys.executable, '-m', 'subapf_planner.tools.bringup', '--world',
                           str(WORLDS / 'fig6d_big_wall.yaml'), '--domain-id', str(domain),
                           '--record', str(bag), '--png', str(tmp_path / 'p.png')],
                          env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
     lines = []
-    for line in p.stdout:
-        lines.append(line)
-        if 'planner driving' in line:
-            break
-    # the check below can see them: bringup, sim_node and planner_node are in the domain
-    assert len(processes_in_domain(domain)) >= 3, ''.join(lines)
-    time.sleep(1.0)   # a second of driving in the bag before the interruption
+    try:
+        for line in p.stdout:
+            lines.append(line)
+            if 'planner driving' in line:
+                break
+        # the check below can see them: bringup, sim_node and planner_node are in the domain
+        assert len(processes_in_domain(domain)) >= 3, ''.join(lines)
+
+        def driven():
+            ex.spin_once(timeout_sec=0.05)
+            assert p.poll() is None, ''.join(lines)
+            return len(forward) >= 5
+        # a second of driving (5 forward commands at 5 Hz) before the interruption
+        wait_for(driven, 30.0, lambda: f'5 forward commands on /cmd_vel ({len(forward)} '
+                 f'came): {"".join(lines)}', interval=0.0)
+    except BaseException:
+        p.send_signal(signal.SIGINT)   # the bringup stops its nodes
+        p.communicate(timeout=60)
+        raise
+    finally:
+        node.destroy_node()
+        rclpy.try_shutdown(context=context)
     p.send_signal(sig)
     out, _ = p.communicate(timeout=60)
     text = ''.join(lines) + out

@@ -44,12 +44,12 @@ def imports_of(path: Path) -> list[tuple[str, int]]:
     return out
 
 
-def layer_of_import(module: str, level: int, layer: str) -> str | None:
-    """The package layer an import reaches, or None for a third-party module."""
-    if level == 1:
-        return layer
-    if level == 2:
-        return module.split('.')[0]
+def layer_of_import(module: str, level: int, package: tuple[str, ...]) -> str | None:
+    """The package layer an import reaches from a module of ``package`` (its folders
+    under subapf_planner/, e.g. ('core', 'critics')), or None for a third-party module."""
+    if level > 0:
+        parts = [*package[:len(package) - (level - 1)], *filter(None, module.split('.'))]
+        return parts[0] if parts else None
     if module.startswith('subapf_planner.'):
         return module.split('.')[1]
     return None
@@ -59,18 +59,23 @@ def modules() -> list[Path]:
     return sorted(p for p in PACKAGE.rglob('*.py') if p.parent != PACKAGE)
 
 
+def folders(path: Path) -> tuple[str, ...]:
+    """A module's folders under subapf_planner/: its layer first."""
+    return path.relative_to(PACKAGE).parts[:-1]
+
+
 def test_every_module_lives_in_a_layer():
-    assert {p.parent.name for p in modules()} == set(ALLOWED_LAYERS)
+    assert {folders(p)[0] for p in modules()} == set(ALLOWED_LAYERS)
     top = {p.name for p in PACKAGE.glob('*.py')}
     assert top == {'__init__.py'}, f'modules outside a layer: {top}'
 
 
-@pytest.mark.parametrize('path', modules(), ids=lambda p: f'{p.parent.name}/{p.name}')
+@pytest.mark.parametrize('path', modules(), ids=lambda p: str(p.relative_to(PACKAGE)))
 def test_imports_follow_the_layer_rule(path):
-    layer = path.parent.name
+    layer = folders(path)[0]
     bad = []
     for module, level in imports_of(path):
-        reached = layer_of_import(module, level, layer)
+        reached = layer_of_import(module, level, folders(path))
         if reached is not None and reached not in ALLOWED_LAYERS[layer]:
             bad.append(f'{module or "."} (level {level}) -> {reached}')
         top = module.split('.')[0]
@@ -85,5 +90,7 @@ def test_the_rule_catches_a_violation(tmp_path):
     bad.parent.mkdir()
     bad.write_text('from ..ros.conversions import scan_from_msg\nimport rclpy\n')
     found = imports_of(bad)
-    assert layer_of_import(*found[0], 'core') == 'ros'
+    assert layer_of_import(*found[0], ('core',)) == 'ros'
+    assert layer_of_import(*found[0], ('core', 'critics')) == 'core'
+    assert layer_of_import('ros.conversions', 3, ('core', 'critics')) == 'ros'
     assert found[1] == ('rclpy', 0)

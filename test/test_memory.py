@@ -220,43 +220,39 @@ def _first_fields(cfg: PlannerConfig) -> NavigationMemory:
     field_period, and computed one for a new goal at 0.4 s."""
     mem = NavigationMemory(cfg)
     mem.integrate(Scan(*enclosure_scan(2.0), 0.0), (0.0, 0.0, 0.0))
-    mem.field_for((0, 0), (1.0, 0.0), now=0.0)
-    assert mem.recomputed
+    assert mem.field_for((0, 0), (1.0, 0.0), now=0.0)[1]
     mem.integrate(Scan(*enclosure_scan(1.5), 0.2), (0.0, 0.0, 0.0))
-    mem.field_for((0, 0), (1.0, 0.0), now=0.2)
-    assert not mem.recomputed                    # grid changed, but within field_period
-    mem.field_for((0, 0), (0.0, 1.0), now=0.4)
-    assert mem.recomputed                        # new goal
+    assert not mem.field_for((0, 0), (1.0, 0.0), now=0.2)[1]   # grid changed, within period
+    assert mem.field_for((0, 0), (0.0, 1.0), now=0.4)[1]       # new goal
     mem.integrate(Scan(*enclosure_scan(1.2), 1.5), (0.0, 0.0, 0.0))
     return mem
 
 
 def test_memory_recomputes_on_a_new_goal_and_at_most_every_field_period():
     mem = _first_fields(PlannerConfig(field_period=1.0, field_worker=False))   # in the call
-    mem.field_for((0, 0), (0.0, 1.0), now=1.5)
-    assert mem.recomputed                        # grid changed, field_period over
+    assert mem.field_for((0, 0), (0.0, 1.0), now=1.5)[1]   # grid changed, field_period over
     mem.integrate(Scan(*enclosure_scan(1.2), 3.0), (0.0, 0.0, 0.0))
-    mem.field_for((0, 0), (0.0, 1.0), now=3.0)
-    assert not mem.recomputed                    # the same walls seen again: no change
+    assert not mem.field_for((0, 0), (0.0, 1.0), now=3.0)[1]   # the same walls: no change
 
 
 def test_with_the_worker_the_map_changes_reach_the_field_at_the_next_call():
     cfg = PlannerConfig(field_period=1.0, field_worker=True)
     mem = _first_fields(cfg)
     before = mem.field
-    assert mem.field_for((0, 0), (0.0, 1.0), now=1.5) is before   # grid changed, period
-    assert not mem.recomputed                    # over: marched in the worker ...
+    field, new = mem.field_for((0, 0), (0.0, 1.0), now=1.5)   # grid changed, period over:
+    assert field is before and not new                        # marched in the worker ...
     # ... not before the cycle is over (start_marching: DecisionLoop.after_tick) ...
     assert not any(t.name.startswith('field') for t in threading.enumerate())
     mem.start_marching()
     assert any(t.name.startswith('field') for t in threading.enumerate())
-    after = mem.field_for((0, 0), (0.0, 1.0), now=1.7)
-    assert mem.recomputed and after is not before   # ... and taken at the next call
+    after, new = mem.field_for((0, 0), (0.0, 1.0), now=1.7)
+    assert new and after is not before   # ... and taken at the next call
     # the field marched in the worker is the one the cycle would have computed
     alone = NavigationMemory(cfg)
     for r, t in ((2.0, 0.0), (1.5, 0.2), (1.2, 1.5)):
         alone.integrate(Scan(*enclosure_scan(r), t), (0.0, 0.0, 0.0))
-    np.testing.assert_array_equal(alone.field_for((0, 0), (0.0, 1.0)).values, after.values)
+    np.testing.assert_array_equal(alone.field_for((0, 0), (0.0, 1.0), -math.inf)[0].values,
+                                  after.values)
 
 
 def test_a_field_being_marched_is_dropped_for_a_new_goal_or_a_forgotten_map():
@@ -265,13 +261,13 @@ def test_a_field_being_marched_is_dropped_for_a_new_goal_or_a_forgotten_map():
     mem.field_for((0, 0), (1.0, 0.0), now=0.0)
     mem.integrate(Scan(*enclosure_scan(1.5), 1.2), (0.0, 0.0, 0.0))
     mem.field_for((0, 0), (1.0, 0.0), now=1.2)   # marching the map's changes
-    new_goal = mem.field_for((0, 0), (0.0, 1.0), now=1.4)
-    assert mem.recomputed and np.allclose(new_goal.goal, (0.0, 1.0))   # in the cycle
-    assert mem.field_for((0, 0), (0.0, 1.0), now=1.6) is new_goal   # the old job: gone
+    new_goal, new = mem.field_for((0, 0), (0.0, 1.0), now=1.4)
+    assert new and np.allclose(new_goal.goal, (0.0, 1.0))   # in the cycle
+    assert mem.field_for((0, 0), (0.0, 1.0), now=1.6)[0] is new_goal   # the old job: gone
     mem.integrate(Scan(*enclosure_scan(1.2), 2.6), (0.0, 0.0, 0.0))
     mem.field_for((0, 0), (0.0, 1.0), now=2.6)
     mem.forget()
-    assert mem.field is None and mem.field_for((0, 0), (0.0, 1.0), now=2.8) is not None
+    assert mem.field is None and mem.field_for((0, 0), (0.0, 1.0), now=2.8)[0] is not None
 
 
 def test_a_thinned_polyline_keeps_its_ends_and_its_spacing():

@@ -12,7 +12,7 @@ from subapf_planner.sim.worldgen import generate, sub_seed
 
 pytestmark = pytest.mark.dds
 
-#: The dev suite's seed (README "World suites").
+#: The dev suite's seed (docs/worlds.md, "World suites").
 DEV_SEED = 2026
 
 

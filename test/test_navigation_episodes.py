@@ -12,7 +12,7 @@ from subapf_planner.sim.worldgen import generate, sub_seed
 
 pytestmark = pytest.mark.sim
 
-#: The dev suite's seed (README "World suites"); worlds named as subapf-worlds names them.
+#: The dev suite's seed (docs/worlds.md, "World suites"); worlds named as subapf-worlds names them.
 DEV_SEED = 2026
 PAPER = PlannerConfig(attraction_field='euclidean')
 

@@ -245,12 +245,23 @@ def test_memory_topics_can_be_switched_off(harness):
     from nav_msgs.msg import OccupancyGrid, Path
     h = harness(publish_map=False, publish_plan=False)
     got = []
-    h.peer.create_subscription(OccupancyGrid, '/subapf_planner/map', got.append, LATCHED_QOS)
-    h.peer.create_subscription(Path, '/subapf_planner/plan', got.append, 10)
+    subs = [h.peer.create_subscription(OccupancyGrid, '/subapf_planner/map', got.append,
+                                       LATCHED_QOS),
+            h.peer.create_subscription(Path, '/subapf_planner/plan', got.append, 10)]
+    # matched both ways first: the node sees the listeners (so, with the topics on, it
+    # would publish) and they see its publishers (so they would get what it sends)
+    assert h.spin_until(lambda: all(s.get_publisher_count() > 0 for s in subs)
+                        and h.node.map_pub.get_subscription_count() > 0
+                        and h.node.plan_pub.get_subscription_count() > 0), \
+        'the map and plan subscriptions never matched the node'
     h.goal(3.0, 0.0)
     assert h.spin_until(lambda: (h.feed(), any(c.twist.linear.x > 0 for c in h.cmds))[1])
-    h.spin_until(lambda: bool(got), timeout=1.0)   # a few cycles after driving
-    assert got == [] and len(h.cmds) >= 3
+    # then 8 more planning cycles of driving (1.6 s), in which a map (at once, then at
+    # map_rate 1 Hz) and a plan (each new field, each second) would have come
+    cycles = len(h.states)
+    assert h.spin_until(lambda: (h.feed(), len(h.states) >= cycles + 8)[1], timeout=10.0), \
+        f'{len(h.states) - cycles} of 8 planning cycles'
+    assert got == [] and len(h.cmds) >= 8
 
 
 def test_views_are_built_only_while_something_subscribes(harness, monkeypatch):
@@ -285,13 +296,25 @@ def test_scans_and_odometry_are_taken_at_the_tick_not_by_the_executor(harness):
     """The inputs' subscriptions are in a group the executor never runs (PolledGroup):
     a scan and odometry that arrived wait in their queues until the planning tick."""
     h = harness(planning_frequency=0.5)
+    # the peer hears the same inputs through ordinary subscriptions, which the executor
+    # runs: when it has them, they have reached this process
+    heard = {'scan': 0, 'odom': 0}
+    for kind, topic, qos in ((LaserScan, 'scan', qos_profile_sensor_data),
+                             (Odometry, 'odom', 10)):
+        h.peer.create_subscription(kind, topic, lambda _, t=topic: heard.update(
+            {t: heard[t] + 1}), qos)
+    assert h.spin_until(lambda: h.scan_pub.get_subscription_count() == 2
+                        and h.odom_pub.get_subscription_count() == 2), \
+        'scan and odom never matched both the node and the peer'
     h.goal(3.0, 0.0)
     assert h.spin_until(lambda: any(s.startswith('waiting') for s in h.states), timeout=8.0)
     for _ in range(3):   # just after a tick: the next is two seconds away
         h.feed()
     polled = [sub for sub, _ in h.node._inputs]
     assert all(not sub.callback_group.can_execute(sub) for sub in polled)
-    h.spin_until(lambda: False, timeout=0.3)   # the executor ran, the 0.5 Hz tick did not
+    # the executor ran until the peer had them all, and 0.3 s more; the 0.5 Hz tick did not
+    assert h.spin_until(lambda: heard == {'scan': 3, 'odom': 3}, timeout=1.0), heard
+    h.spin_until(lambda: False, timeout=0.3)
     assert h.node.ctl.scan is None and h.node.ctl.pose is None
     assert h.spin_until(lambda: bool(h.cmds), timeout=5.0)   # the tick took them in
     assert h.node.ctl.scan is not None and h.node.ctl.pose is not None

@@ -6,7 +6,7 @@ import signal
 import time
 import xml.etree.ElementTree as ET
 
-from conftest import PARAMS, WORLDS
+from conftest import PARAMS, WORLDS, wait_for
 from geometry_msgs.msg import TwistStamped
 from nav_msgs.msg import Odometry
 import pytest
@@ -234,18 +234,32 @@ def test_a_node_stops_when_the_process_that_started_it_is_killed(ros_env):
             f"p = start('sim_node', ['-p', 'world:={WORLD}'], dict(os.environ), quiet=True)\n"
             'print(p.pid, flush=True)\n'
             'time.sleep(120)\n')
+    context = rclpy.Context()
+    rclpy.init(context=context)   # in the test's domain (ros_env), as the child
+    node = rclpy.create_node('watcher', context=context)
+    ex = SingleThreadedExecutor(context=context)
+    ex.add_node(node)
+    truth = []
+    node.create_subscription(Odometry, 'ground_truth', truth.append, 10)
     parent = subprocess.Popen([sys.executable, '-c', code], env=ros_env,
                               stdout=subprocess.PIPE, text=True)
     try:
         child = int(parent.stdout.readline())
-        time.sleep(3.0)
-        assert not gone(child)
+
+        def publishing():
+            ex.spin_once(timeout_sec=0.05)
+            assert not gone(child), f'sim_node (process {child}) ended before it published'
+            return truth
+        # the node is up and running: its simulation publishes
+        wait_for(publishing, 60.0, f'ground truth from sim_node (process {child})',
+                 interval=0.0)
         parent.kill()
         parent.wait(timeout=10)
-        deadline = time.monotonic() + 20.0
-        while not gone(child) and time.monotonic() < deadline:
-            time.sleep(0.2)
-        assert gone(child)
+        wait_for(lambda: gone(child), 20.0,
+                 f'sim_node (process {child}) to end after its parent was killed',
+                 interval=0.2)
     finally:
         parent.kill()
         parent.wait()
+        node.destroy_node()
+        rclpy.try_shutdown(context=context)

@@ -15,8 +15,9 @@ from sensor_msgs.msg import LaserScan
 
 from subapf_planner.core.command import Command, forward_blocked
 from subapf_planner.core.config import METHODS, PlannerConfig
+from subapf_planner.core.gates import FIRST_SCANS
 from subapf_planner.core.loop import DecisionLoop, Supervision
-from subapf_planner.core.planner import FIRST_SCANS, Planner, PlanResult, plan
+from subapf_planner.core.planner import Planner, PlanResult, plan
 from subapf_planner.core.scan import Scan, geometry_warning
 from subapf_planner.core.status import State, Status
 from subapf_planner.ros.planner_node import PlannerNode
@@ -55,7 +56,8 @@ def test_fuzz_core_plan(method, x, y, yaw, gx, gy, obstacles, v0, w0):
        angle_min=weird, inc=weird, rmin=weird, rmax=weird, pose=st.tuples(coord, coord, weird))
 @settings(max_examples=1000, deadline=None)
 def test_fuzz_core_scans(ranges, angle_min, inc, rmin, rmax, pose):
-    result = Planner(CFG).step(pose, (2.0, 2.0), Scan(ranges, angle_min, inc, rmin, rmax))
+    result = Planner(CFG).step(pose, (2.0, 2.0), Scan(ranges, angle_min, inc, rmin, rmax),
+                               now=0.0)
     check_command(result.command, pose, result.obstacles)
 
 

@@ -53,8 +53,11 @@ def test_rosbags_reads_the_same_messages(bag):
 
 @pytest.mark.parametrize('bag', BAGS, ids=lambda p: p.stem)
 def test_replay_reproduces_recorded_commands(bag, capsys, tmp_path):
+    """Every command as recorded, within 1e-6 (m/s, rad/s): a change of behaviour moves
+    a command by far more; another numpy or SciPy release may move the last bits of a
+    field and, through the memory, a command by some 1e-8."""
     out = tmp_path / 'replayed.mcap'
-    assert replay_main([str(bag), '--tolerance', '1e-9', '-o', str(out)]) == 0
+    assert replay_main([str(bag), '--tolerance', '1e-6', '-o', str(out)]) == 0
     text = capsys.readouterr().out
     assert 'first divergence: none' in text
     n = int(text.split('commands compared: ')[1].split()[0])
@@ -137,7 +140,7 @@ def assert_same_answers(over_dds, in_process, share: float = 0.75):
 def paper_params(tmp_path) -> Path:
     """config/planner.yaml with the paper's memoryless attraction. Through the node, the
     default's memory carries on the difference a scan still in transit at its tick
-    makes (README, "Recording and replay"); the paper's method has no memory, so
+    makes (docs/recording.md); the paper's method has no memory, so
     there a late scan costs one tick, not the rest of the run."""
     text = PARAMS.read_text()
     assert text.count('attraction_field: geodesic') == 1

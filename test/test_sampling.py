@@ -11,13 +11,9 @@ import pytest
 from subapf_planner.core.apf import apf_force, apf_step
 from subapf_planner.core.command import shape_command
 from subapf_planner.core.config import PlannerConfig
+from subapf_planner.core.critics.priority import priority_applies
 from subapf_planner.core.planner import local_radius, plan
-from subapf_planner.core.sampling import (
-    circle_samples,
-    clearance,
-    priority_applies,
-    sample_and_choose,
-)
+from subapf_planner.core.sampling import circle_samples, clearance, sample_and_choose
 from subapf_planner.core.scan import voxel_downsample
 from subapf_planner.core.status import Status
 

@@ -11,19 +11,22 @@ from subapf_planner.core.config import PlannerConfig
 from subapf_planner.core.evasion import (
     STATIC_MARGIN,
     Escape,
+    candidates,
     evade,
     halted,
     moving_gap,
     rollout,
-    rollouts,
+    rollout_step,
 )
 from subapf_planner.core.planner import Planner
+from subapf_planner.core.rollout import rollouts
 from subapf_planner.core.scan import Scan
 from subapf_planner.core.tracking import Tracker, Tracks
 
 pytestmark = pytest.mark.core
 
 CFG = PlannerConfig()
+DT = CFG.period   # the evasion's rollout step at 5 Hz
 N = 360
 ANGLES = 2 * math.pi * np.arange(N) / N
 
@@ -187,11 +190,11 @@ def test_a_plan_that_keeps_clear_is_kept():
 
 
 def test_rollout_is_a_unicycle():
-    path = rollout(np.array([0.0, 0.0, 0.0]), 0.2, math.pi / 4, 2.0)
+    path = rollout(np.array([0.0, 0.0, 0.0]), 0.2, math.pi / 4, 2.0, DT)
     # a quarter circle of radius 0.2 / (pi / 4) m
     r = 0.2 / (math.pi / 4)
     np.testing.assert_allclose(path[-1], [r, r], atol=1e-9)
-    np.testing.assert_allclose(rollout(np.array([1.0, 0.0, math.pi]), 0.1, 0.0, 1.0)[-1],
+    np.testing.assert_allclose(rollout(np.array([1.0, 0.0, math.pi]), 0.1, 0.0, 1.0, DT)[-1],
                                [0.9, 0.0], atol=1e-12)
 
 
@@ -199,7 +202,7 @@ def test_turn_then_straight_rollout_is_exact():
     """A quarter of a turn at pi/4 rad/s for 1 s, then 1 s straight: the arc's end,
     then 0.2 m along the new heading (the per-step chord is exact)."""
     w = math.pi / 4
-    path = rollouts(np.zeros(3), np.array([0.2]), np.array([[w] * 5 + [0.0] * 5]))[0]
+    path = rollouts(np.zeros(3), np.array([0.2]), np.array([[w] * 5 + [0.0] * 5]), DT)[0]
     r = 0.2 / w
     arc_end = np.array([r * math.sin(w), r * (1 - math.cos(w))])
     np.testing.assert_allclose(path[4], arc_end, atol=1e-12)
@@ -221,16 +224,36 @@ def test_head_on_in_a_corridor_steps_to_the_wider_side_and_keeps_to_it():
     pose = np.array([0.0, -0.02, 0.0])
     esc = evade(pose, (0.22, 0.0), walker, corridor_walls(), CFG, False)
     assert esc is not None
-    end = rollouts(pose, np.array([esc.v]), np.array([esc.turn]))[0, -1]
+    end = rollouts(pose, np.array([esc.v]), np.array([esc.turn]), DT)[0, -1]
     assert end[1] < -0.2                                          # to the right (y < 0)
     nxt = esc.advanced()
     assert len(nxt.turn) == len(esc.turn) and nxt.turn[:-1] == esc.turn[1:]
     moved = Tracks(walker.position + 0.2 * walker.velocity, walker.velocity, walker.radius,
                    walker.moving, walker.held, walker.point_track)
-    pose2 = np.array([*rollouts(pose, np.array([esc.v]), np.array([esc.turn]))[0, 0],
+    pose2 = np.array([*rollouts(pose, np.array([esc.v]), np.array([esc.turn]), DT)[0, 0],
                       pose[2] + esc.turn[0] * 0.2])
     again = evade(pose2, (0.22, 0.0), moved, corridor_walls(), CFG, False, nxt)
     assert again == nxt
+
+
+@pytest.mark.parametrize('hz', [1.0, 5.0, 10.0, 20.0])
+def test_a_committed_escape_advances_one_planning_period_at_any_rate(hz):
+    """The rollout step divides the period (and is at most 0.2 s); an escape that turns
+    for 0.6 s then drives straight turns for 0.6 s at every rate, and advanced once a
+    period for a second it has 1 s less of its turn left (with a fixed 0.2 s step, at
+    20 Hz it would have run through 4 s of its manoeuvre)."""
+    cfg = CFG.replace(planning_frequency=hz)
+    dt, per = rollout_step(cfg.period)
+    assert dt * per == pytest.approx(cfg.period) and dt <= 0.2 + 1e-12
+    esc = next(e for e in candidates(cfg)
+               if e.v > 0 and e.turn[0] != 0.0 and e.turn[-1] == 0.0
+               and sum(w != 0.0 for w in e.turn) * dt == pytest.approx(1.2))
+    later = esc
+    for _ in range(int(round(hz))):   # one second of planning periods
+        later = later.advanced()
+    assert len(later.turn) == len(esc.turn)
+    assert sum(w != 0.0 for w in later.turn) * dt == pytest.approx(0.2)
+    assert len(esc.turn) * dt == pytest.approx(cfg.prediction_horizon)
 
 
 def test_escape_command_is_its_first_step():
@@ -243,7 +266,7 @@ def test_a_rollout_halts_before_a_static_point():
     step within robot_radius + STATIC_MARGIN of it at the point before; a path that
     never comes that close, and any path without static points, is unchanged."""
     pose = np.zeros(3)
-    paths = rollouts(pose, np.array([0.2, -0.2]), np.zeros((2, 15)))
+    paths = rollouts(pose, np.array([0.2, -0.2]), np.zeros((2, 15)), DT)
     wall = np.column_stack((np.full(41, 0.5), np.linspace(-1.0, 1.0, 41)))
     out, first = halted(pose, paths, wall, CFG.robot_radius)
     limit = 0.5 - CFG.robot_radius - STATIC_MARGIN
@@ -269,9 +292,9 @@ def test_chased_towards_a_wall_it_steps_aside_instead_of_running_ahead():
     wall = np.column_stack((np.full(81, 0.5), np.linspace(-2.0, 2.0, 81)))
     esc = evade(pose, (0.0, 0.0), chaser, wall, CFG, False)
     assert esc is not None and esc.turn[0] != 0.0
-    path, _ = halted(pose, rollouts(pose, np.array([esc.v]), np.array([esc.turn])), wall,
+    path, _ = halted(pose, rollouts(pose, np.array([esc.v]), np.array([esc.turn]), DT), wall,
                      CFG.robot_radius)
-    assert moving_gap(path[0], chaser, CFG.robot_radius) >= CFG.moving_clearance
+    assert moving_gap(path[0], chaser, CFG.robot_radius, DT) >= CFG.moving_clearance
     ahead, _ = halted(pose, rollouts(pose, np.array([CFG.max_linear_velocity]),
-                                     np.zeros((1, len(esc.turn)))), wall, CFG.robot_radius)
-    assert moving_gap(ahead[0], chaser, CFG.robot_radius) < CFG.moving_clearance
+                                     np.zeros((1, len(esc.turn))), DT), wall, CFG.robot_radius)
+    assert moving_gap(ahead[0], chaser, CFG.robot_radius, DT) < CFG.moving_clearance

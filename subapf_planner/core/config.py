@@ -16,6 +16,7 @@ from typing import Any, Mapping
 
 import yaml
 
+from .critics import critic_class
 from .params import ConfigError, build, check_fields, param
 from .robot import BURGER, RobotDescription
 
@@ -26,7 +27,7 @@ METHODS = APF_METHODS + ('dwa',)
 
 @dataclass(frozen=True)
 class PlannerConfig:
-    """All parameters of the planner core; see README 'Parameters'."""
+    """All parameters of the planner core; see docs/parameters.md."""
 
     # --- method and potentials (paper Sections II-III) ---------------------------------
     method: str = param('subharmonic_sampling', "Planner: the paper's full method, "
@@ -58,8 +59,13 @@ class PlannerConfig:
     priority_angle: float = param(0.8, 'theta threshold of Fig. 5: priority only when goal '
                                    'and nearest obstacle bearings differ by less', 'rad',
                                    0.0, math.pi)
-    priority_bonus: float = param(0.25, 'Subtracted from the score of the priority sample',
-                                   'm', 0.0, 10.0)
+    priority_bonus: float = param(0.25, 'priority critic: subtracted from the score of the '
+                                   'priority sample', 'm', 0.0, 10.0)
+    critics: tuple[str, ...] = param(('progress', 'priority'), 'Scoring terms of the '
+                                     'circular sampling, summed in this order '
+                                     '(core/critics/): progress (Algorithm 1: distance to '
+                                     'go after the next APF step), priority (Fig. 5); a '
+                                     'critic of your own as module:Class')
     # --- scan conversion ---------------------------------------------------------------
     voxel_size: float = param(0.05, 'Grid cell for downsampling laser points (one point per '
                                "cell), so a wall's push does not grow with beam density",
@@ -140,13 +146,12 @@ class PlannerConfig:
     field_worker: bool = param(True, "A field that only brings the map's changes in is "
                                'marched on a worker thread between cycles and used from the '
                                'next cycle: a tick never waits for it (the map reaches the '
-                               'field a cycle late; README, Performance)')
+                               'field a cycle late; docs/performance.md)')
     scan_alignment: bool = param(True, 'Match each scan to the memory before it is written '
                                  '(core/alignment.py): drifting wheel odometry is corrected, '
                                  'and the memory, the field and the goal live in the '
-                                 'corrected frame (with the geodesic attraction; README, '
-                                 'Getting there in buildings). Switching it starts an empty '
-                                 'map')
+                                 'corrected frame (with the geodesic attraction; '
+                                 'docs/alignment.md). Switching it starts an empty map')
     # --- moving obstacles (core/tracking.py, core/evasion.py) ------------------------
     track_moving: bool = param(True, 'Track moving obstacles from the scans (clusters, '
                                'constant-velocity Kalman filters): their points stay out of '
@@ -171,15 +176,24 @@ class PlannerConfig:
                                  'reverses; the robot backs at up to its top speed: '
                                  'slower, a walker at that speed catches it)', 'm/s', 0.0,
                                  5.0)
+    escape_turn_weight: float = param(0.1, 'Among the escapes that keep moving_clearance, '
+                                      'the one closest to the planned command wins: '
+                                      '|v - v_plan| + this * |w - w_plan| (a difference of '
+                                      'turn rate counts this much against one of speed, so '
+                                      'the robot steps aside rather than turns back)',
+                                      'm/rad', 0.0, 10.0)
     # --- DWA baseline (Fox, Burgard, Thrun 1997) ---------------------------------------
     dwa_clearance: float = param(BURGER.clearance, 'DWA: arcs passing closer than this to an '
                                  'obstacle point are inadmissible (robot_radius + 0.03 m)',
                                  'm', 0.0, 2.0)
     dwa_horizon: float = param(2.0, 'DWA rollout horizon', 's', 0.2, 10.0)
+    dwa_rollout_step: float = param(0.1, 'DWA: arcs are checked every this long (at top '
+                                    'speed a step should stay below dwa_clearance)', 's',
+                                    0.01, 1.0)
     dwa_v_samples: int = param(7, 'DWA linear velocity samples', '', 2, 50)
     dwa_w_samples: int = param(15, 'DWA angular velocity samples', '', 3, 101)
     dwa_heading_weight: float = param(0.2, 'DWA weight of the goal term (weights tuned once '
-                                      'on the dev suite, README)', '', 0.0, 100.0)
+                                      'on the dev suite, docs/design.md)', '', 0.0, 100.0)
     dwa_clearance_weight: float = param(0.6, 'DWA weight of the clearance term', '',
                                          0.0, 100.0)
     dwa_velocity_weight: float = param(0.4, 'DWA weight of the forward-speed term', '',
@@ -187,6 +201,8 @@ class PlannerConfig:
 
     def __post_init__(self) -> None:
         check_fields(self)
+        for name in self.critics:
+            critic_class(name)   # ConfigError for a name that is no critic
         if self.sample_radius >= self.danger_distance * 4:
             raise ConfigError('sample_radius: must be below 4 * danger_distance '
                               f'({self.sample_radius} >= {4 * self.danger_distance})')

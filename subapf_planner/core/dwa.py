@@ -24,17 +24,15 @@ memory it lacks (docs/paper_notes.md section 5).
 from __future__ import annotations
 
 from dataclasses import dataclass
-import math
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from .config import PlannerConfig
 from .navigation import NavigationField
+from .rollout import arcs
 from .sampling import clearance
 
-#: Rollout resolution [s].
-ROLLOUT_DT = 0.1
 #: Clearances above this count as fully clear in the score [m].
 CLEARANCE_CAP = 1.0
 
@@ -49,20 +47,10 @@ class DwaResult:
     trajectory: NDArray[np.float64]
 
 
-def rollout(pose: ArrayLike, v: NDArray, w: NDArray, horizon: float) -> NDArray[np.float64]:
-    """Positions (k, T, 2) of k unicycle arcs (v, w) from pose (x, y, yaw), T steps of 0.1 s."""
-    x, y, yaw = (float(c) for c in pose)
-    t = ROLLOUT_DT * np.arange(1, max(1, int(round(horizon / ROLLOUT_DT))) + 1)
-    v = np.asarray(v, float)[:, None]
-    w = np.asarray(w, float)[:, None]
-    th = yaw + w * t
-    straight = np.abs(w) < 1e-6
-    w_safe = np.where(straight, 1.0, w)
-    px = np.where(straight, x + v * t * math.cos(yaw), x + v / w_safe * (np.sin(th)
-                                                                           - math.sin(yaw)))
-    py = np.where(straight, y + v * t * math.sin(yaw), y - v / w_safe * (np.cos(th)
-                                                                           - math.cos(yaw)))
-    return np.stack((px, py), axis=-1)
+def rollout(pose: ArrayLike, v: NDArray, w: NDArray, cfg: PlannerConfig) -> NDArray[np.float64]:
+    """Positions (k, T, 2) of k unicycle arcs (v, w) from pose (x, y, yaw) over
+    dwa_horizon, in steps of dwa_rollout_step (core/rollout.py)."""
+    return arcs(pose, v, w, cfg.dwa_horizon, cfg.dwa_rollout_step)
 
 
 def dwa_command(pose: ArrayLike, goal: ArrayLike, previous: tuple[float, float],
@@ -80,7 +68,7 @@ def dwa_command(pose: ArrayLike, goal: ArrayLike, previous: tuple[float, float],
     vs, ws = np.meshgrid(np.linspace(v_lo, v_hi, cfg.dwa_v_samples),
                          np.linspace(w_lo, w_hi, cfg.dwa_w_samples))
     vs, ws = vs.ravel(), ws.ravel()
-    paths = rollout(pose, vs, ws, cfg.dwa_horizon)
+    paths = rollout(pose, vs, ws, cfg)
     k, steps, _ = paths.shape
     clear = clearance(paths.reshape(-1, 2), obstacles).reshape(k, steps).min(axis=1)
     admissible = (clear > cfg.dwa_clearance) | (vs <= 1e-9)

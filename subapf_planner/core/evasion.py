@@ -3,7 +3,8 @@ obstacles will be, and replaced when it meets one.
 
 The APF command (core/planner.py) only sees where things are. Each cycle this
 layer rolls the command out for ``prediction_horizon`` seconds (a unicycle at
-constant (v, w), ROLLOUT_DT steps) against each moving track's constant-velocity
+constant (v, w), core/rollout.py, in steps of the planning period or a whole fraction of
+it: rollout_step) against each moving track's constant-velocity
 prediction (core/tracking.py): the gap between the footprint and the track's
 disc must stay above ``moving_clearance``. When it does not, a small set of
 escape manoeuvres is rolled out the same way (all at once, as arrays): forward,
@@ -33,18 +34,22 @@ from numpy.typing import NDArray
 from scipy.spatial import cKDTree
 
 from .config import PlannerConfig
+from .rollout import arcs, rollouts, steps
 from .tracking import Tracks
 
-#: Rollout step [s].
-ROLLOUT_DT = 0.2
-#: An escape must clear the static points for this long [s] ...
+#: Longest rollout step [s]: the step divides the planning period, so a committed
+#: escape advances by whole steps (at the default 5 Hz one step is one period).
+MAX_ROLLOUT_STEP = 0.2
+#: An escape must clear the static points for this long [s] (one second of braking
+#: distance at any speed the robot drives) ...
 EVASION_COMMIT = 1.0
-#: ... by this much beyond the footprint [m].
+#: ... by this much beyond the footprint [m] (the width of one map cell is too coarse).
 STATIC_MARGIN = 0.02
 #: A meeting t seconds ahead counts as a gap this much larger per second [m/s]
-#: (soon matters more than later).
+#: (soon matters more than later: a later meeting leaves time to change course).
 TIME_DISCOUNT = 0.05
-#: Angular rates of the escape candidates, as fractions of the top turn rate.
+#: Angular rates of the escape candidates, as fractions of the top turn rate (five
+#: keep the candidate set small enough to roll out every cycle).
 TURN_FRACTIONS = (-0.6, -0.3, 0.0, 0.3, 0.6)
 #: How long a turning candidate turns before it drives straight [s] (None: the whole
 #: horizon, a constant arc). Turn-then-straight is how one steps aside to pass someone.
@@ -54,88 +59,82 @@ TURN_TIMES = (None, 0.6, 1.2)
 HYSTERESIS = 0.02
 
 
+def rollout_step(period: float) -> tuple[float, int]:
+    """The evasion's rollout step [s] for a planning ``period`` [s], and how many of
+    them make a period: the period itself, or a whole fraction of it no longer than
+    MAX_ROLLOUT_STEP."""
+    per = max(1, math.ceil(period / MAX_ROLLOUT_STEP - 1e-9))
+    return period / per, per
+
+
 @dataclass(frozen=True)
 class Escape:
     """An escape manoeuvre: forward speed ``v`` [m/s] and the turn rate of each rollout
-    step (k,) [rad/s]; the command now is (v, turn[0])."""
+    step (k,) [rad/s], ``per_period`` steps to a planning period; the command now is
+    (v, turn[0])."""
 
     v: float
     turn: tuple[float, ...]
+    per_period: int = 1
 
     @property
     def command(self) -> tuple[float, float]:
         return (self.v, self.turn[0])
 
     def advanced(self) -> Escape:
-        """The same manoeuvre one planning period (ROLLOUT_DT) later."""
-        return Escape(self.v, self.turn[1:] + self.turn[-1:])
+        """The same manoeuvre one planning period later (its last turn rate held)."""
+        m = min(self.per_period, len(self.turn))
+        return Escape(self.v, self.turn[m:] + self.turn[-1:] * m, self.per_period)
 
 
-def _steps(horizon: float) -> int:
-    return max(1, int(round(horizon / ROLLOUT_DT)))
-
-
-def rollouts(pose: NDArray[np.float64], v: NDArray[np.float64],
-             turn: NDArray[np.float64]) -> NDArray[np.float64]:
-    """Positions (c, k, 2) [m] of c unicycles from ``pose`` (x, y, yaw), each at forward
-    speed v (c,) [m/s] and turn rate turn (c, k) [rad/s] held over each ROLLOUT_DT
-    step (first point one step ahead). Exact for piecewise-constant rates: a step's
-    chord has length v dt sinc(w dt / 2) along the heading at its middle."""
-    half = 0.5 * turn * ROLLOUT_DT
-    yaw0 = pose[2] + np.concatenate([np.zeros((len(v), 1)), np.cumsum(2.0 * half, axis=1)[:, :-1]],
-                                    axis=1)
-    chord = v[:, None] * ROLLOUT_DT * np.sinc(half / np.pi)
-    mid = yaw0 + half
-    return np.stack((pose[0] + np.cumsum(chord * np.cos(mid), axis=1),
-                     pose[1] + np.cumsum(chord * np.sin(mid), axis=1)), axis=-1)
-
-
-def rollout(pose: NDArray[np.float64], v: float, w: float, horizon: float) -> NDArray:
+def rollout(pose: NDArray[np.float64], v: float, w: float, horizon: float,
+            dt: float) -> NDArray:
     """Positions (k, 2) [m] of a unicycle from ``pose`` (x, y, yaw) at constant (v, w),
-    every ROLLOUT_DT up to ``horizon`` [s] (first point one step ahead)."""
-    return rollouts(pose, np.array([v]), np.full((1, _steps(horizon)), w))[0]
+    every ``dt`` up to ``horizon`` [s] (first point one step ahead)."""
+    return arcs(pose, [v], [w], horizon, dt)[0]
 
 
-def _gaps(paths: NDArray[np.float64], tracks: Tracks,
-          robot_radius: float) -> NDArray[np.float64]:
+def _gaps(paths: NDArray[np.float64], tracks: Tracks, robot_radius: float,
+          dt: float) -> NDArray[np.float64]:
     """Gap [m] (c, k) at each rollout step between the footprint along each of the paths
-    (c, k, 2) (one point per ROLLOUT_DT from one step ahead) and the nearest moving
+    (c, k, 2) (one point per ``dt`` [s] from one step ahead) and the nearest moving
     track's predicted disc; inf with none."""
     m = tracks.moving
     if not np.any(m):
         return np.full(paths.shape[:2], math.inf)
-    t = (np.arange(paths.shape[1]) + 1)[:, None] * ROLLOUT_DT                 # (k, 1)
+    t = (np.arange(paths.shape[1]) + 1)[:, None] * dt                         # (k, 1)
     where = tracks.position[m][None] + t[..., None] * tracks.velocity[m][None]   # (k, n, 2)
     d = paths[:, :, None, :] - where[None]                                      # (c, k, n, 2)
     gap = np.hypot(d[..., 0], d[..., 1]) - tracks.radius[m] - robot_radius
     return gap.min(axis=2)
 
 
-def _discounted(gaps: NDArray[np.float64]) -> NDArray[np.float64]:
-    """The smallest time-discounted gap of each rollout (c,) [m]."""
-    t = (np.arange(gaps.shape[1]) + 1) * ROLLOUT_DT
+def _discounted(gaps: NDArray[np.float64], dt: float) -> NDArray[np.float64]:
+    """The smallest time-discounted gap of each rollout (c,) [m] (steps of ``dt``)."""
+    t = (np.arange(gaps.shape[1]) + 1) * dt
     return (gaps + TIME_DISCOUNT * t).min(axis=1)
 
 
-def moving_gaps(paths: NDArray[np.float64], tracks: Tracks,
-                robot_radius: float) -> NDArray[np.float64]:
+def moving_gaps(paths: NDArray[np.float64], tracks: Tracks, robot_radius: float,
+                dt: float) -> NDArray[np.float64]:
     """Smallest time-discounted gap [m] (c,) between the footprint along each of the
-    paths (c, k, 2) (one point per ROLLOUT_DT from one step ahead) and the moving tracks'
-    predicted discs; inf with none."""
-    return _discounted(_gaps(paths, tracks, robot_radius))
+    paths (c, k, 2) (one point per ``dt`` [s] from one step ahead) and the moving
+    tracks' predicted discs; inf with none."""
+    return _discounted(_gaps(paths, tracks, robot_radius, dt), dt)
 
 
-def moving_gap(path: NDArray[np.float64], tracks: Tracks, robot_radius: float) -> float:
+def moving_gap(path: NDArray[np.float64], tracks: Tracks, robot_radius: float,
+               dt: float) -> float:
     """:func:`moving_gaps` of one path (k, 2)."""
-    return float(moving_gaps(path[None], tracks, robot_radius)[0])
+    return float(moving_gaps(path[None], tracks, robot_radius, dt)[0])
 
 
-def contact_time(gaps: NDArray[np.float64]) -> NDArray[np.float64]:
-    """When each rollout (c, k gaps) first touches a track's predicted disc [s]; inf for
-    one that never does within the horizon."""
+def contact_time(gaps: NDArray[np.float64], dt: float) -> NDArray[np.float64]:
+    """When each rollout (c, k gaps, steps of ``dt``) first touches a track's predicted
+    disc [s]; inf for one that never does within the horizon."""
     touch = gaps < 0.0
     first = np.argmax(touch, axis=1)
-    return np.where(touch.any(axis=1), (first + 1) * ROLLOUT_DT, math.inf)
+    return np.where(touch.any(axis=1), (first + 1) * dt, math.inf)
 
 
 def halted(pose: NDArray[np.float64], paths: NDArray[np.float64], static: NDArray,
@@ -161,8 +160,10 @@ def halted(pose: NDArray[np.float64], paths: NDArray[np.float64], static: NDArra
 
 def candidates(cfg: PlannerConfig) -> list[Escape]:
     """The escape manoeuvres: each speed (top, half, standing, backing at reverse_speed)
-    with each turn rate of TURN_FRACTIONS, turning for each of TURN_TIMES."""
-    k = _steps(cfg.prediction_horizon)
+    with each turn rate of TURN_FRACTIONS, turning for each of TURN_TIMES, in rollout
+    steps of the planning period (rollout_step)."""
+    dt, per = rollout_step(cfg.period)
+    k = steps(cfg.prediction_horizon, dt)
     speeds = [cfg.max_linear_velocity, 0.5 * cfg.max_linear_velocity, 0.0]
     if cfg.reverse_speed > 0.0:
         speeds.append(-cfg.reverse_speed)
@@ -171,8 +172,8 @@ def candidates(cfg: PlannerConfig) -> list[Escape]:
         for f in TURN_FRACTIONS:
             w = f * cfg.max_angular_velocity
             for turning in (TURN_TIMES if f != 0.0 and v != 0.0 else (None,)):
-                n = k if turning is None else min(k, _steps(turning))
-                out.append(Escape(v, (w,) * n + (0.0,) * (k - n)))
+                n = k if turning is None else min(k, steps(turning, dt))
+                out.append(Escape(v, (w,) * n + (0.0,) * (k - n), per))
     return out
 
 
@@ -186,8 +187,9 @@ def evade(pose: NDArray[np.float64], planned: tuple[float, float], tracks: Track
     cycle, advanced one period, kept while it still keeps the clearance (no dithering
     between escapes)."""
     v0, w0 = planned
-    if moving_gap(rollout(pose, v0, w0, cfg.prediction_horizon), tracks, cfg.robot_radius) \
-            >= cfg.moving_clearance:
+    dt, _ = rollout_step(cfg.period)
+    if moving_gap(rollout(pose, v0, w0, cfg.prediction_horizon, dt), tracks,
+                  cfg.robot_radius, dt) >= cfg.moving_clearance:
         return None
     options = candidates(cfg)
     k = len(options[0].turn)
@@ -195,21 +197,21 @@ def evade(pose: NDArray[np.float64], planned: tuple[float, float], tracks: Track
         options.append(committed)
     v = np.array([e.v for e in options])
     turn = np.array([e.turn for e in options])
-    paths, halt = halted(pose, rollouts(pose, v, turn), static, cfg.robot_radius)
+    paths, halt = halted(pose, rollouts(pose, v, turn, dt), static, cfg.robot_radius)
     ok = ~((v > 0.0) & blocked_ahead)
-    ok &= (v == 0.0) | (halt >= _steps(EVASION_COMMIT))
+    ok &= (v == 0.0) | (halt >= steps(EVASION_COMMIT, dt))
     if not np.any(ok):
         return None
-    gaps = _gaps(paths, tracks, cfg.robot_radius)
-    gap = np.where(ok, _discounted(gaps), -math.inf)
-    touch = np.where(ok, contact_time(gaps), -math.inf)
+    gaps = _gaps(paths, tracks, cfg.robot_radius, dt)
+    gap = np.where(ok, _discounted(gaps, dt), -math.inf)
+    touch = np.where(ok, contact_time(gaps, dt), -math.inf)
     kept = np.zeros(len(options), bool)
     if committed is not None and options[-1] is committed:
         kept[-1] = ok[-1]
     safe = ok & (gap >= cfg.moving_clearance)
     if np.any(safe):
         # the committed escape, else the one closest to the plan (then the larger gap)
-        near = np.abs(v - v0) + 0.1 * np.abs(turn[:, 0] - w0)
+        near = np.abs(v - v0) + cfg.escape_turn_weight * np.abs(turn[:, 0] - w0)
         score = np.where(kept, -1.0, near)
         return options[int(np.lexsort((-gap, np.where(safe, score, math.inf)))[0])]
     # none keeps the clearance: one that never touches, else the latest touch; then the

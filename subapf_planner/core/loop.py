@@ -5,8 +5,9 @@ arrays with their times and publishes what ``tick`` decides; the replay
 (ros/replay.py) feeds it a recorded bag the same way; the benchmark's episode
 (sim/episode.py) feeds it the simulator's scans and odometry on simulated time.
 Times are seconds on the node's clock (simulated time under ``use_sim_time``).
-Each ``tick`` supervises (goal, freshness, progress) and runs one planning step
-(core/planner.py: perceive, gate, plan).
+Each ``tick`` runs the supervisors (core/supervisors.py: goal, inputs, freshness,
+given up; then arrival, unreachable, progress with its recoveries) around one
+planning step (core/planner.py: perceive, then the cycle's stages).
 
 States (:class:`~.status.State`, the text of ``~/status`` before the colon):
 idle, waiting, driving, reached, stopped, stuck (the progress checker gave the
@@ -23,25 +24,19 @@ import math
 import numpy as np
 
 from .config import PlannerConfig
+from .cycle import PlanResult
 from .memory import SAME_GOAL
 from .occupancy import OccupancyGrid
 from .params import check_fields, param
-from .planner import Planner, PlanResult
+from .planner import Planner
 from .scan import Scan
-from .status import State, Status
+from .status import State
+from .supervisors import SUPERVISORS, Recoveries
 
 #: Odometry poses kept to place each scan at the pose it was taken from.
 POSE_HISTORY = 100
 #: A scan is placed with the odometry pose nearest its stamp, if within this [s].
 POSE_MATCH = 0.1
-#: The progress checker waits while a moving obstacle is this close [m]: giving way to
-#: someone is not being stuck.
-GIVING_WAY_DISTANCE = 2.0
-
-
-#: Statuses under which the goal cannot be reached for now; unreachable_timeout of them
-#: ends the attempt.
-NO_WAY = (Status.GOAL_UNREACHABLE, Status.GOAL_IN_OBSTACLE)
 
 
 @dataclass(frozen=True)
@@ -61,6 +56,11 @@ class Supervision:
                             'marks the place the field leads into as tried (blocked in the '
                             'field for avoid_time) so that the field leads along another way',
                             '', 0, 100)
+    avoid_distance: float = param(0.5, 'The recovery marks the place this far along the '
+                                  "field's descent tried (the door or gap the robot is "
+                                  'pushing at)', 'm', 0.05, 5.0)
+    avoid_radius: float = param(0.35, 'The place marked tried is a disc of this radius (a '
+                                'door and its sides)', 'm', 0.05, 5.0)
     avoid_time: float = param(60.0, 'How long a tried place stays blocked in the field (then '
                               'it opens again: a door that was only briefly blocked)', 's',
                               1.0, 3600.0)
@@ -69,6 +69,9 @@ class Supervision:
                                        '(state unreachable); a way that opens before (a '
                                        'door, someone who walked off) restarts the clock',
                                        's', 1.0, 3600.0)
+    giving_way_distance: float = param(2.0, 'The progress checker waits while a moving '
+                                       'obstacle is this close (giving way to someone is '
+                                       'not being stuck)', 'm', 0.0, 20.0)
 
     def __post_init__(self) -> None:
         check_fields(self)
@@ -105,17 +108,32 @@ class DecisionLoop:
         self.goal_in_map = False
         self.state = State.IDLE
         self.reason = 'no goal'
-        self._progress: tuple[np.ndarray, float] | None = None
-        self._unreachable_since: float | None = None
-        self._tried = 0   # ways marked tried for this goal (recoveries)
+        self.supervisors = tuple(cls() for cls in SUPERVISORS)
+        self.recoveries = Recoveries()
 
     @property
     def cfg(self) -> PlannerConfig:
+        """The planner's configuration (change it with :meth:`reconfigure`)."""
         return self.planner.cfg
 
-    @cfg.setter
-    def cfg(self, cfg: PlannerConfig) -> None:
-        self.planner.cfg = cfg
+    def reconfigure(self, cfg: PlannerConfig, limits: Supervision | None = None) -> None:
+        """Plan with ``cfg`` (Planner.reconfigure) and, when given, supervise with
+        ``limits`` from the next tick."""
+        self.planner.reconfigure(cfg)
+        if limits is not None:
+            self.limits = limits
+
+    @property
+    def correction(self) -> tuple[float, float, float]:
+        """The memory's frame in odom (x, y, yaw): the scan alignment's correction as the
+        last scan taken into the memory left it."""
+        return self.planner.correction
+
+    @property
+    def field_seconds(self) -> float:
+        """How long the newest navigation field took to compute [s] (wall clock: a
+        figure for benchmarks, not for decisions)."""
+        return self.planner.memory.compute_seconds
 
     @property
     def grid(self) -> OccupancyGrid:
@@ -137,7 +155,7 @@ class DecisionLoop:
     def seed_command(self, command: tuple[float, float]) -> None:
         """The command the robot was last sent by someone else (a replay that starts
         mid-run): the next command's acceleration limits start from it."""
-        self.planner.previous = (float(command[0]), float(command[1]))
+        self.planner.seed(command)
 
     @property
     def text(self) -> str:
@@ -157,10 +175,15 @@ class DecisionLoop:
             return False
         self.goal, self.goal_in_map = goal.copy(), bool(in_map)
         self.planner.reset()
-        self._progress = self._unreachable_since = None
-        self._tried = 0
+        for s in self.supervisors:
+            s.reset()
+        self.recoveries.tried = 0
         self._set(State.DRIVING, 'new goal')
         return True
+
+    def clear_goal(self) -> None:
+        """The goal is done (reached): none until the next."""
+        self.goal = None
 
     def clock_jumped(self) -> None:
         """The clock jumped (a restarted simulation, a bag played from elsewhere): forget
@@ -168,7 +191,8 @@ class DecisionLoop:
         self.scan = self.scan_time = self.pose = self.odom_time = None
         self.poses.clear()
         self.planner.forget()
-        self._progress = self._unreachable_since = None
+        for s in self.supervisors:
+            s.restart()
         if self.goal is not None:
             self._set(State.DRIVING, 'clock jumped')
 
@@ -198,14 +222,6 @@ class DecisionLoop:
                 best, nearest = gap, pose
         return nearest if best <= POSE_MATCH else self.pose
 
-    def _set(self, state: State, reason: str) -> None:
-        self.state, self.reason = state, reason
-
-    def _decide(self, command: tuple[float, float] | None, state: State, reason: str,
-                result: PlanResult | None = None) -> Decision:
-        self._set(state, reason)
-        return Decision(command, state, reason, result)
-
     def silent(self, now: float) -> tuple[bool, bool]:
         """Whether the scan, and the odometry, are silent at ``now`` [s]: none taken
         yet, or the newest older than scan_timeout (odom_timeout)."""
@@ -213,83 +229,40 @@ class DecisionLoop:
         return (self.scan_time is None or now - self.scan_time > lim.scan_timeout,
                 self.odom_time is None or now - self.odom_time > lim.odom_timeout)
 
-    def _stop(self, state: State, reason: str, result: PlanResult | None = None) -> Decision:
+    def _set(self, state: State, reason: str) -> None:
+        self.state, self.reason = state, reason
+
+    def decide(self, command: tuple[float, float] | None, state: State, reason: str,
+               result: PlanResult | None = None) -> Decision:
+        """The tick's decision: publish ``command`` (None: nothing), in ``state``."""
+        self._set(state, reason)
+        return Decision(command, state, reason, result)
+
+    def stop(self, state: State, reason: str, result: PlanResult | None = None) -> Decision:
+        """The tick's decision: stand still in ``state`` (the planner's last command
+        and what its stages keep for the goal are cleared)."""
         self.planner.reset()
-        return self._decide((0.0, 0.0), state, reason, result)
+        return self.decide((0.0, 0.0), state, reason, result)
+
+    def hold(self) -> Decision:
+        """The tick's decision: stand still in the state and for the reason as they are."""
+        return Decision((0.0, 0.0), self.state, self.reason)
 
     def tick(self, now: float) -> Decision:
-        """One planning period at time ``now`` [s]."""
-        lim = self.limits
-        if self.goal is None:
-            return self._decide(None, State.IDLE, 'no goal')
-        if self.scan is None or self.pose is None:
-            return self._decide(None, State.WAITING,
-                                f'no {"scan" if self.scan is None else "odom"} yet')
-        scan_silent, odom_silent = self.silent(now)
-        if scan_silent:
-            return self._stop(State.STOPPED, 'scan is stale')
-        if odom_silent:
-            return self._stop(State.STOPPED, 'odometry is stale')
-        if self.state.gave_up:
-            return Decision((0.0, 0.0), self.state, self.reason)
+        """One planning period at time ``now`` [s]: the supervisors around one planning
+        step (core/supervisors.py)."""
+        for s in self.supervisors:
+            decision = s.before(self, now)
+            if decision is not None:
+                return decision
         result = self.planner.step(self.pose, self.goal, self.scan,
-                                   self.pose_at(self.scan.stamp), now,
+                                   self.pose_at(self.scan.stamp), now=now,
                                    goal_in_map=self.goal_in_map)
+        for s in self.supervisors:
+            decision = s.after(self, result, now)
+            if decision is not None:
+                return decision
         cmd = result.command
-        if cmd.status is Status.REACHED:
-            self.goal = None
-            return self._stop(State.REACHED, 'goal within tolerance', result)
-        if self._unreachable_too_long(cmd.status, now):
-            tried = f' (every way tried: {self._tried})' if self._tried else ''
-            return self._stop(State.UNREACHABLE, f'no way to the goal for '
-                              f'{lim.unreachable_timeout:g} s{tried}, goal abandoned', result)
-        if _giving_way(result, self.pose):
-            self._progress = None
         if cmd.status.stops:
-            if cmd.status is Status.NO_SAFE_MOVE and self._no_progress(now):
-                return self._recover(result, (0.0, 0.0), now)   # standing at a gap
-            return self._stop(State.STOPPED, cmd.status, result)
-        if self._no_progress(now):
-            return self._recover(result, (cmd.v, cmd.w), now)
-        return self._decide((cmd.v, cmd.w), State.DRIVING, cmd.status, result)
-
-    def _recover(self, result: PlanResult, command: tuple[float, float],
-                 now: float) -> Decision:
-        """No progress: mark the way ahead tried (Planner.avoid_ahead) and go on, at most
-        ``recoveries`` times for a goal; then abandon it (state stuck)."""
-        lim = self.limits
-        if self._tried < lim.recoveries and self.planner.avoid_ahead(now + lim.avoid_time):
-            self._tried += 1
-            self._progress = None
-            return self._decide(command, State.DRIVING,
-                                f'no progress: the way ahead marked tried ({self._tried} of '
-                                f'{lim.recoveries}), another way', result)
-        return self._stop(State.STUCK, 'no progress, goal abandoned', result)
-
-    def _unreachable_too_long(self, status: Status, now: float) -> bool:
-        """Whether ``goal_unreachable`` or ``goal_in_obstacle`` (NO_WAY: a goal the
-        robot cannot stand at is no nearer) has lasted longer than unreachable_timeout
-        (any other status restarts the clock)."""
-        if status not in NO_WAY:
-            self._unreachable_since = None
-            return False
-        if self._unreachable_since is None:
-            self._unreachable_since = now
-        return now - self._unreachable_since > self.limits.unreachable_timeout
-
-    def _no_progress(self, now: float) -> bool:
-        if self._progress is None or np.hypot(*(self.pose[:2] - self._progress[0])) >= \
-                self.limits.progress_distance:
-            self._progress = (self.pose[:2].copy(), now)
-            return False
-        return now - self._progress[1] > self.limits.progress_timeout
-
-
-def _giving_way(result: PlanResult, pose: np.ndarray) -> bool:
-    """A moving track is within GIVING_WAY_DISTANCE of the robot (at ``pose`` in odom,
-    or the result's own pose: the tracks are in the memory's frame)."""
-    t = result.tracks
-    if not np.any(t.moving):
-        return False
-    pose = pose if result.pose is None else result.pose
-    return bool(np.min(np.hypot(*(t.position[t.moving] - pose[:2]).T)) < GIVING_WAY_DISTANCE)
+            return self.stop(State.STOPPED, cmd.status, result)
+        return self.decide((cmd.v, cmd.w), State.DRIVING, cmd.status, result)

@@ -85,7 +85,6 @@ class NavigationMemory:
         self._field_key: tuple | None = None    # (goal, grid version) of self.field
         self._field_time = -math.inf
         self._scan_stamp: float | None = None
-        self.recomputed = False   # whether the last field_for() computed a new field
         self.computations = 0     # fields computed so far
         #: How long the last field took to compute [s] (wall clock, in the cycle or the
         #: worker: a figure for subapf-perf, not for decisions).
@@ -169,7 +168,6 @@ class NavigationMemory:
                  when: float) -> None:
         self.field, self.compute_seconds = computed
         self._field_key, self._field_time = key, when
-        self.recomputed = True
         self.computations += 1
 
     def _key(self, goal: NDArray) -> tuple:
@@ -273,30 +271,32 @@ class NavigationMemory:
         return bool(0 <= rel[0] < w and 0 <= rel[1] < h)
 
     def field_for(self, position: ArrayLike, goal: ArrayLike,
-                  now: float | None = None) -> NavigationField | None:
-        """The field to ``goal`` (None: the goal is blocked in the map), recomputed per the
-        module docstring; ``now`` None recomputes whenever the occupied cells changed, in
-        the call."""
+                  now: float) -> tuple[NavigationField | None, bool]:
+        """The field to ``goal`` (None: the goal is blocked in the map) at time ``now``
+        [s], recomputed per the module docstring, and whether this call installed a new
+        one. ``now`` -inf: no field_period (a new field whenever the occupied cells
+        changed, computed in the call)."""
         p = np.asarray(position, float)[:2]
         g = np.asarray(goal, float)[:2]
-        self.recomputed = False
+        timed = math.isfinite(now)
+        installed = self.computations
         self.start_marching()   # (if nobody did since the last call)
         if self._pending is not None:   # the field marched since the last call
             (marching, job), self._pending = self._pending, None
             self._install(marching.result(), job.key, job.time)
-        if now is not None and any(now >= a[3] for a in self.avoided):
+        if timed and any(now >= a[3] for a in self.avoided):
             self._field_key = None   # an avoided place opens again
         key = self._key(g)
         same_goal = self._field_key is not None and self._field_key[0] == key[0]
         fresh = same_goal and (key[1] == self._field_key[1] or (
-            now is not None and now - self._field_time < self.cfg.field_period))
+            timed and now - self._field_time < self.cfg.field_period))
         covered = self.field is None or self._covers(p)
         if fresh and covered:
-            return self.field
+            return self.field, self.computations != installed
         if self.cfg.field_worker and same_goal and covered and self.field is not None \
-                and now is not None:
+                and timed:
             self._march_later(g, p, now)   # only the map's changes: the next call has it
-            return self.field
-        self._install(self._compute(self._blocked(now), self.grid.origin, g, p), key,
-                      -math.inf if now is None else now)
-        return self.field
+            return self.field, self.computations != installed
+        self._install(self._compute(self._blocked(now if timed else None), self.grid.origin,
+                                    g, p), key, now if timed else -math.inf)
+        return self.field, True

@@ -34,8 +34,9 @@ def param(default: Any, description: str, unit: str = '', lo: float | None = Non
 
 
 def kind_of(f: dataclasses.Field) -> type:
-    """bool, int, float or str: the declared type of a field."""
-    return {'bool': bool, 'int': int, 'float': float, 'str': str}.get(f.type, f.type)
+    """bool, int, float, str or tuple (of strings): the declared type of a field."""
+    return {'bool': bool, 'int': int, 'float': float, 'str': str,
+            'tuple[str, ...]': tuple}.get(f.type, f.type)
 
 
 def check_field(f: dataclasses.Field, value: Any) -> None:
@@ -52,6 +53,9 @@ def check_field(f: dataclasses.Field, value: Any) -> None:
         raise ConfigError(f'{name}: expected true or false, got {value!r}')
     elif kind is str and not isinstance(value, str):
         raise ConfigError(f'{name}: expected a string, got {value!r}')
+    elif kind is tuple and not (isinstance(value, tuple)
+                                and all(isinstance(v, str) for v in value)):
+        raise ConfigError(f'{name}: expected a list of strings, got {value!r}')
     if meta.get('choices') is not None and value not in meta['choices']:
         raise ConfigError(f'{name}: {value!r} is not one of {", ".join(meta["choices"])}')
     lo, hi = meta.get('lo'), meta.get('hi')
@@ -78,6 +82,8 @@ def build(cls: type[T], values: Mapping[str, Any], *, ignore_unknown: bool = Fal
             v = values[name]
             if kind_of(f) is float and isinstance(v, int) and not isinstance(v, bool):
                 v = float(v)
+            elif kind_of(f) is tuple and isinstance(v, list):
+                v = tuple(v)
             kwargs[name] = v
     return cls(**kwargs)
 

@@ -1,75 +1,57 @@
-"""The planning step: perceive, gate, plan: (pose, scan, goal) -> command + diagnostics.
+"""The planning step: (pose, scan, goal) -> command + diagnostics, as a pipeline.
 
-One cycle of :meth:`Planner.step` (the decision loop, core/loop.py, calls it once
-per period):
+One call of :meth:`Planner.step` (the decision loop, core/loop.py, calls it once per
+period) is one cycle (core/cycle.py):
 
-1. **perceive**: the scan's valid returns -> point obstacles (scan.py, with the
-   laser mounting of robot.py), placed with the scan alignment's correction
-   (odom -> the memory's frame) as the last scan left it; moving obstacles are
-   tracked (tracking.py). With ``attraction_field: geodesic`` (the default) the
-   scan then goes into the occupancy memory (memory.py), but only once the
-   cycle's command is out (:meth:`Planner.perceive`, from
-   DecisionLoop.after_tick; the next step does it first if nobody did, so the
-   result is the same): with ``scan_alignment`` it is matched to the memory
-   (alignment.py; the correction it finds places the next cycle's robot, scan
-   and goal, so drifting odometry does not draw walls twice), then the trail of
-   what moved is cleared and the scan written, the moving tracks' points kept
-   out. The command does not wait for the memory; the memory a cycle plans with
-   holds the scans up to the one before (the scan itself is in the cycle's
-   obstacles), its correction is one scan old (what odometry drifts in 0.2 s);
-2. **gate**: the inputs (:func:`input_status`: non-finite pose or goal; a scan
-   with a bad geometry) and the goal (:func:`goal_status`: reached, inside an
-   obstacle; with the memory, unreachable through it) each stop the robot with
-   their status;
-3. **plan** (:func:`local_plan`, pure): the raw next move point of the APF step,
-   eq. (23) (apf.py), circular sampling, Algorithm 1 and the Fig. 5 priority
-   (sampling.py), the chosen point -> (v, w) (command.py). With the memory the
-   attraction of eq. (21) is replaced by the navigation field (navigation.py);
-   last, the command is checked against where the moving tracks will be, and
-   replaced when it meets one (evasion.py).
+1. **inputs**: a pose or goal that is not finite numbers, or a scan with a bad
+   geometry, stops the robot (``invalid_pose``, ``invalid_goal``, ``invalid_scan``);
+2. **perceive**: the scan's valid returns -> point obstacles (scan.py, with the
+   laser mounting of robot.py), placed with the scan alignment's correction (odom
+   -> the memory's frame) as the last scan left it; moving obstacles are tracked
+   (tracking.py). With the memory the scan goes into it only once the cycle's command
+   is out (:meth:`Planner.perceive`, from DecisionLoop.after_tick; the next step does
+   it first if nobody did, so the result is the same): with ``scan_alignment`` it is
+   matched to the memory (alignment.py; the correction it finds places the next
+   cycle's robot, scan and goal), then the trail of what moved is cleared and the
+   scan written, the moving tracks' points kept out;
+3. **stages** (core/pipeline.py chooses them from the parameters): the gates
+   (core/gates.py: goal, mapping, reachability), the proposer (core/proposers.py:
+   the APF step with circular sampling and its critics, the APF step alone, DWA),
+   the filters (core/filters.py: evasion);
+4. **finish**: the result carries the pose planned from and the correction; a
+   command that stops the robot clears the last command and the stages' memory of
+   this goal (``reset``).
 
-``subharmonic``, ``traditional`` and ``harmonic`` skip the sampling and steer
-to the raw point (the paper's ablations); ``dwa`` replaces the APF step, the
-sampling and the command shaping (dwa.py). :func:`plan` is steps 2-3 from
-obstacle points, for callers without a scan.
+:func:`plan` is the goal gate and the proposer from obstacle points, for callers
+without a scan or a memory.
 """
 
 from __future__ import annotations
 
 import dataclasses
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 import math
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from .alignment import Match, within_drift
-from .apf import apf_step
-from .command import Command, forward_blocked, shape_command
+from .command import Command
 from .config import PlannerConfig
-from .dwa import dwa_command
-from .evasion import Escape, evade
+from .cycle import Cycle, PlanResult
+from .gates import goal_status, input_status
 from .memory import SAME_GOAL, NavigationMemory
 from .navigation import NavigationField
+from .pipeline import Pipeline
+from .proposers import local_radius
 from .robot import compose, invert, to_parent
-from .sampling import SamplingResult, clearance, sample_and_choose
-from .scan import Scan, ScanError, scan_to_points, voxel_downsample
+from .sampling import clearance
+from .scan import Scan, ScanError, scan_to_points
 from .status import Status
 from .tracking import NO_TRACKS, Tracker, Tracks
 
-_EMPTY = np.zeros((0, 2))
-#: A place tried and not passed (Planner.avoid_ahead): this far ahead along the field's
-#: descent [m] ...
-AVOID_AHEAD = 0.5
-#: ... a disc of this radius [m] (a door and its sides).
-AVOID_RADIUS = 0.35
-#: With the scan alignment, the robot stands until the memory holds this many scans: the
-#: first walls are established (three hits) from where it started, before any drift; for
-#: this many cycles at most (a scan repeated with the same stamp is not taken twice).
-FIRST_SCANS = 3
-#: Inside goal_tolerance, a cycle that brings the robot less than this closer to the goal
-#: ends the approach (it cannot get closer: arrival_distance) [m].
-ARRIVAL_PROGRESS = 0.002
+__all__ = ['Perception', 'PlanResult', 'Planner', 'goal_status', 'input_status',
+           'local_radius', 'plan']
 
 
 @dataclass(frozen=True)
@@ -90,64 +72,8 @@ class Perception:
     trail: NDArray[np.float64]
 
 
-@dataclass(frozen=True)
-class PlanResult:
-    """Command and what led to it (points in the odom frame, metres)."""
-
-    command: Command
-    raw_point: NDArray[np.float64] | None = None
-    chosen_point: NDArray[np.float64] | None = None
-    sampling: SamplingResult | None = None
-    obstacles: NDArray[np.float64] = field(default_factory=lambda: _EMPTY)
-    nearest_distance: float = math.inf
-    goal_distance: float = math.nan
-    field: NavigationField | None = None
-    #: Whether this cycle computed a new navigation field (the expensive part).
-    new_field: bool = False
-    #: The tracked obstacles of this cycle's scan (core/tracking.py).
-    tracks: Tracks = NO_TRACKS
-    #: The robot's pose (x, y, yaw) the cycle planned from, in the memory's frame ...
-    pose: NDArray[np.float64] | None = None
-    #: ... which is odom corrected by this (x, y, yaw) (the scan alignment; Planner.step).
-    correction: tuple[float, float, float] = (0.0, 0.0, 0.0)
-
-
-def input_status(pose: ArrayLike, goal: ArrayLike) -> Status | None:
-    """Gate on the inputs: ``invalid_pose`` for a pose that is not three finite numbers
-    (x, y, yaw), ``invalid_goal`` for a goal that is not two; None when both are fine."""
-    if np.shape(pose) != (3,) or not all(math.isfinite(v) for v in pose):
-        return Status.INVALID_POSE
-    if np.shape(goal) != (2,) or not all(math.isfinite(v) for v in goal):
-        return Status.INVALID_GOAL
-    return None
-
-
-def goal_status(cfg: PlannerConfig, goal_distance: float, goal: NDArray[np.float64],
-                obstacles: NDArray[np.float64]) -> Status | None:
-    """Gate on the goal, ``goal_distance`` [m] from the robot: ``reached`` within
-    goal_tolerance; ``goal_in_obstacle`` when a laser point lies within robot_radius of
-    it (the robot could not stand there); None otherwise."""
-    if goal_distance <= cfg.goal_tolerance:
-        return Status.REACHED
-    if float(clearance(goal, obstacles)[0]) < cfg.robot_radius:
-        return Status.GOAL_IN_OBSTACLE
-    return None
-
-
-def local_radius(cfg: PlannerConfig) -> float:
-    """Obstacle points farther than this from the robot cannot change a planning cycle of
-    the APF methods [m]: the raw point and the samples lie within ``max_step + 2 *
-    sample_radius`` of it, and no term looks farther than the repulsion's influence (a
-    voxel's centroid may lie up to a voxel diagonal from its points), the Fig. 5
-    priority distance, the discard distance or the safety corridor."""
-    return (max(cfg.influence_distance + math.sqrt(2.0) * cfg.voxel_size,
-                cfg.priority_distance, cfg.discard_distance, cfg.safety_distance)
-            + cfg.max_step + 2.0 * cfg.sample_radius)
-
-
 def _situation(pose: NDArray, goal: NDArray, obstacles: ArrayLike) -> dict:
-    """Finite obstacle points (m, 2) and the robot's distances to them and to the goal,
-    the diagnostics every PlanResult of a cycle carries."""
+    """Finite obstacle points (m, 2) and the robot's distances to them and to the goal."""
     obs = np.asarray(obstacles, float).reshape(-1, 2)
     obs = obs[np.all(np.isfinite(obs), axis=1)]
     position = pose[:2]
@@ -158,9 +84,10 @@ def _situation(pose: NDArray, goal: NDArray, obstacles: ArrayLike) -> dict:
 def plan(cfg: PlannerConfig, pose: ArrayLike, goal: ArrayLike, obstacles: ArrayLike,
          previous: tuple[float, float] = (0.0, 0.0),
          field: NavigationField | None = None) -> PlanResult:
-    """Gate and plan one cycle from obstacle points: pose (x, y, yaw), goal (x, y),
-    obstacles (m, 2), all in odom; ``previous`` the last command (v, w); ``field`` the
-    navigation-function attraction (None: Euclidean, eq. 21).
+    """The goal gate and the proposer of ``cfg.method`` for one cycle from obstacle
+    points: pose (x, y, yaw), goal (x, y), obstacles (m, 2), all in one frame;
+    ``previous`` the last command (v, w); ``field`` the navigation-function attraction
+    (None: Euclidean, eq. 21).
 
     Never raises for bad numbers: a non-finite pose or goal gives a stop with
     status ``invalid_pose`` / ``invalid_goal``; non-finite obstacle points are dropped.
@@ -171,31 +98,12 @@ def plan(cfg: PlannerConfig, pose: ArrayLike, goal: ArrayLike, obstacles: ArrayL
     if status is not None:
         return PlanResult(Command(0.0, 0.0, status))
     seen = _situation(pose, goal, obstacles)
-    status = goal_status(cfg, seen['goal_distance'], goal, seen['obstacles'])
-    if status is not None:
-        return PlanResult(Command(0.0, 0.0, status), field=field, **seen)
-    return local_plan(cfg, pose, goal, seen, previous, field)
-
-
-def local_plan(cfg: PlannerConfig, pose: NDArray, goal: NDArray, seen: dict,
-               previous: tuple[float, float], field: NavigationField | None) -> PlanResult:
-    """Step 3 of the module docstring for inputs that passed the gates; ``seen`` as
-    :func:`_situation` gives it."""
-    obs = seen['obstacles']
-    if cfg.method == 'dwa':
-        return _plan_dwa(cfg, pose, goal, previous, seen, field)
-    position = pose[:2]
-    offset = obs - position
-    near = obs[offset[:, 0] ** 2 + offset[:, 1] ** 2 <= local_radius(cfg) ** 2]
-    repulsors = voxel_downsample(near, cfg.voxel_size)
-    raw = apf_step(position, goal, repulsors, cfg, field)[0]
-    sampling = None
-    target: NDArray | None = raw
-    if cfg.method == 'subharmonic_sampling':
-        sampling = sample_and_choose(raw, position, goal, near, repulsors, cfg, field)
-        target = sampling.chosen
-    cmd = shape_command(pose, target, goal, previous, near, cfg)
-    return PlanResult(cmd, raw, target, sampling, field=field, **seen)
+    cycle = Cycle(cfg, 0.0, cfg.period, pose, goal, seen['obstacles'], tracks=NO_TRACKS,
+                  previous=previous, field=field, **seen)
+    cycle = cycle.with_(status=goal_status(cfg, cycle.goal_distance, goal, cycle.obstacles))
+    if cycle.status is not None:
+        return cycle.stopped().result
+    return Pipeline(cfg, None).proposer.run(cycle).result
 
 
 def _tracker_settings(cfg: PlannerConfig) -> tuple[float, float, float, float]:
@@ -206,60 +114,60 @@ def _tracker(cfg: PlannerConfig) -> Tracker:
     return Tracker(*_tracker_settings(cfg))
 
 
-def _plan_dwa(cfg: PlannerConfig, pose: NDArray, goal: NDArray,
-              previous: tuple[float, float], seen: dict,
-              field: NavigationField | None) -> PlanResult:
-    obs = seen['obstacles']
-    res = dwa_command(pose, goal, previous, voxel_downsample(obs, cfg.voxel_size), cfg, field)
-    if not res.admissible:
-        return PlanResult(Command(0.0, 0.0, Status.NO_SAFE_MOVE), field=field, **seen)
-    v, status = res.v, Status.DRIVING if res.v > 0.0 else Status.TURNING
-    if v > 0.0 and forward_blocked(pose, obs, cfg):
-        v, status = 0.0, Status.BLOCKED_AHEAD
-    return PlanResult(Command(v, res.w, status), None, res.trajectory[-1].copy(), field=field,
-                      **seen)
-
-
 class Planner:
-    """The planning step with its state: the last command (acceleration limits) and, with
-    the geodesic attraction, the occupancy memory and its navigation field."""
+    """The planning step with its state: the last command (acceleration limits), the
+    stages (core/pipeline.py) with what they remember, and, with the geodesic
+    attraction, the occupancy memory and its navigation field."""
 
     def __init__(self, cfg: PlannerConfig) -> None:
         self._cfg = cfg
         self.previous: tuple[float, float] = (0.0, 0.0)
         self.memory = NavigationMemory(cfg)
         self.tracker = _tracker(cfg)
-        self._escape: Escape | None = None   # the escape of the last cycle, if it evaded
-        self._approach: tuple[NDArray, float] | None = None   # last cycle's goal, distance
+        self.pipeline = Pipeline(cfg, self.memory)
         #: The last cycle's scan, for the memory (perceive).
         self._perception: Perception | None = None
         self._clear_alignment()
 
     @property
     def cfg(self) -> PlannerConfig:
+        """The configuration (change it with :meth:`reconfigure`)."""
         return self._cfg
 
-    @cfg.setter
-    def cfg(self, cfg: PlannerConfig) -> None:
+    def reconfigure(self, cfg: PlannerConfig) -> None:
+        """Plan with ``cfg`` from the next cycle. The same configuration again changes
+        nothing; another one drops the scan waiting for the memory (its returns were
+        placed with the old laser mounting), rebuilds the tracker when its settings
+        changed and the memory when its grid did (core/memory.py), and chooses the
+        stages anew (each keeps what it remembers)."""
+        if cfg == self._cfg:
+            return
         if _tracker_settings(cfg) != _tracker_settings(self._cfg):
             self.tracker = _tracker(cfg)
         self._cfg = cfg
         self._perception = None
         self.memory.reconfigure(cfg)
+        self.pipeline.configure(cfg)
+
+    def seed(self, command: tuple[float, float]) -> None:
+        """The command (v, w) the robot was last sent: the next command's acceleration
+        limits start from it."""
+        self.previous = (float(command[0]), float(command[1]))
 
     def reset(self) -> None:
-        """Forget the last command and escape (after a stop, a new goal or a fault); the
-        map stays."""
+        """Forget the last command and what the stages keep for the goal (after a stop,
+        a new goal or a fault); the map stays."""
         self.previous = (0.0, 0.0)
-        self._escape = None
+        self.pipeline.reset()
 
     def forget(self) -> None:
-        """Forget the last command, the map and the tracks (a restarted simulation)."""
+        """Forget the last command, the map, the tracks and the stages' memory (a
+        restarted simulation)."""
         self.reset()
         self.memory.forget()
         self.tracker.reset()
+        self.pipeline.forget()
         self._perception = None
-        self._approach = None
         self._clear_alignment()
 
     def _clear_alignment(self) -> None:
@@ -270,20 +178,25 @@ class Planner:
         self._aligned_from: NDArray | None = None   # odom pose of the last scan matched
         self._goal: tuple[NDArray, NDArray] | None = None   # (in odom, in the memory's frame)
         self._planned_from: NDArray | None = None   # the last cycle's pose (memory's frame)
-        self._mapping_cycles = 0   # cycles stood for the first walls (FIRST_SCANS)
+
+    @property
+    def planned_from(self) -> NDArray[np.float64] | None:
+        """The pose (x, y, yaw) the last cycle planned from, in the memory's frame."""
+        return self._planned_from
 
     def step(self, pose: ArrayLike, goal: ArrayLike, scan: Scan,
-             scan_pose: ArrayLike | None = None, now: float | None = None,
+             scan_pose: ArrayLike | None = None, *, now: float,
              goal_in_map: bool = False) -> PlanResult:
-        """Perceive, gate and plan one cycle (module docstring) for the robot at ``pose``
+        """One cycle (module docstring) at time ``now`` [s] for the robot at ``pose``
         (x, y, yaw) in odom driving to ``goal`` (x, y) in odom (with ``goal_in_map``: in
         the memory's frame). The result's points, field and ``pose`` are in the memory's
         frame: odom corrected by ``result.correction`` (the identity without scan
         alignment; the memory's frame is odom as it was at the start).
 
         ``scan_pose``: base_footprint's odom pose when the scan was taken (default
-        ``pose``); a robot that moved since is planned for from ``pose``. ``now`` [s]
-        rate-limits the navigation field (None: recomputed whenever the map changed).
+        ``pose``); a robot that moved since is planned for from ``pose``. ``now`` paces
+        the navigation field (field_period; -inf: a new field whenever the map
+        changed).
         """
         cfg = self.cfg
         pose = np.asarray(pose, float).ravel()
@@ -305,36 +218,29 @@ class Planner:
         if cfg.geodesic:   # the memory takes the scan in once the command is out
             self._perception = Perception(scan, base, odom_scan_pose, goal, transient,
                                           tracks.trail)
-        seen = _situation(pose, goal, points)
-        status = goal_status(cfg, seen['goal_distance'], goal, seen['obstacles'])
-        if status is None and cfg.geodesic and cfg.scan_alignment and self._mapping():
-            status = Status.MAPPING
-        if status is Status.REACHED and self._drives_on(goal, seen['goal_distance']):
-            status = None
-        self._approach = (goal, seen['goal_distance'])
-        field, new_field = None, False
-        if status is None and cfg.geodesic:   # the goal through the memory
-            field = self.memory.field_for(pose[:2], goal, now)
-            new_field = self.memory.recomputed
-            if field is None or not field.reachable(pose[:2]):
-                status = Status.GOAL_UNREACHABLE
-        if status is not None:
-            result = PlanResult(Command(0.0, 0.0, status), field=field, new_field=new_field,
-                                tracks=tracks, **seen)
-        else:
-            result = local_plan(cfg, pose, goal, seen, self.previous, field)
-            if new_field or tracks is not NO_TRACKS:
-                result = dataclasses.replace(result, new_field=new_field, tracks=tracks)
-        if status is not Status.REACHED and np.any(tracks.moving) and cfg.method != 'dwa':
-            result = self._out_of_the_way(pose, result, points)
-        else:
-            self._escape = None
+        cycle = Cycle(cfg, now, cfg.period, pose, goal, points, tracks=tracks,
+                      previous=self.previous,
+                      memory_scans=self.memory.grid.scans + (self._perception is not None),
+                      **_situation(pose, goal, points))
+        result = self._run_stages(cycle)
         result = dataclasses.replace(result, pose=pose, correction=self.correction)
         self._planned_from = pose
         if result.command.status.stops:
             return self._stop(result)
         self.previous = (result.command.v, result.command.w)
         return result
+
+    def _run_stages(self, cycle: Cycle) -> PlanResult:
+        """The gates until one stops the cycle, the proposer if none did, the filters."""
+        stages = self.pipeline
+        for gate in stages.gates:
+            cycle = gate.run(cycle)
+            if cycle.status is not None:
+                break
+        cycle = stages.proposer.run(cycle) if cycle.status is None else cycle.stopped()
+        for f in stages.filters:
+            cycle = f.run(cycle)
+        return cycle.result
 
     def after_tick(self) -> None:
         """The work between this cycle and the next, once the command is out: the scan
@@ -362,42 +268,6 @@ class Planner:
         if len(seen.trail):
             self.memory.clear(seen.trail)
         self.memory.integrate(seen.scan, self.in_map(seen.scan_pose), seen.goal, seen.transient)
-
-    def _mapping(self) -> bool:
-        """Whether this cycle stands for the first walls (FIRST_SCANS, the cycle's own
-        scan, which the memory takes after it, counted; counts the cycle)."""
-        scans = self.memory.grid.scans + (self._perception is not None)
-        if scans >= FIRST_SCANS or self._mapping_cycles >= FIRST_SCANS:
-            return False
-        self._mapping_cycles += 1
-        return True
-
-    def _drives_on(self, goal: NDArray, distance: float) -> bool:
-        """Inside goal_tolerance at ``distance`` [m] from ``goal``: whether to drive on
-        (geodesic only): farther than arrival_distance and at least ARRIVAL_PROGRESS
-        closer than the last cycle, or its first cycle inside."""
-        cfg = self.cfg
-        if not cfg.geodesic or distance <= cfg.arrival_distance:
-            return False
-        if self._approach is None or not np.array_equal(self._approach[0], goal):
-            return True
-        before = self._approach[1]
-        return before > cfg.goal_tolerance or before - distance >= ARRIVAL_PROGRESS
-
-    def avoid_ahead(self, until: float) -> bool:
-        """Mark the place the navigation field leads the robot into next (AVOID_AHEAD
-        along its descent from the last cycle's pose, a disc of AVOID_RADIUS) as tried,
-        blocked in the field until ``until`` [s]; False without a field or a way."""
-        f, pose = self.memory.field, self._planned_from
-        if f is None or pose is None:
-            return False
-        path = f.path(pose[:2], max_length=2.0 * AVOID_AHEAD)
-        if len(path) < 2:
-            return False
-        along = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(path, axis=0).T))])
-        self.memory.avoid(path[min(int(np.searchsorted(along, AVOID_AHEAD)), len(path) - 1)],
-                          AVOID_RADIUS, until)
-        return True
 
     def in_map(self, pose: ArrayLike) -> NDArray[np.float64]:
         """An odom pose (x, y, yaw) in the memory's frame (odom corrected by the scan
@@ -446,28 +316,15 @@ class Planner:
         return self._goal[1]
 
     def _track(self, scan: Scan, points: NDArray,
-               now: float | None) -> tuple[Tracks, NDArray[np.bool_] | None]:
+               now: float) -> tuple[Tracks, NDArray[np.bool_] | None]:
         """The tracks of this scan, and per beam whether it returned from a moving one."""
         t = scan.stamp if math.isfinite(scan.stamp) else now
-        if not self.cfg.tracks_moving or t is None or not math.isfinite(t):
+        if not self.cfg.tracks_moving or not math.isfinite(t):
             return NO_TRACKS, None
         tracks = self.tracker.update(points, t, self.memory.log_odds_at(points))
         transient = np.zeros(np.size(scan.ranges), bool)
         transient[np.flatnonzero(scan.valid(self.cfg.obstacle_range))] = tracks.held_points
         return tracks, transient
-
-    def _out_of_the_way(self, pose: NDArray, result: PlanResult,
-                        points: NDArray) -> PlanResult:
-        """The result with its command replaced when that would meet a moving track."""
-        cfg, tracks, cmd = self.cfg, result.tracks, result.command
-        static = points[~tracks.moving_points]
-        alt = evade(pose, (cmd.v, cmd.w), tracks, static, cfg,
-                    forward_blocked(pose, points, cfg),
-                    None if self._escape is None else self._escape.advanced())
-        self._escape = alt
-        if alt is None:
-            return result
-        return dataclasses.replace(result, command=Command(*alt.command, Status.EVADING))
 
     def _stop(self, result: PlanResult) -> PlanResult:
         self.reset()

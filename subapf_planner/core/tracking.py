@@ -57,9 +57,8 @@ MOVE_DISTANCE = 0.3
 #: ... or this far, if it was new when first seen (standing on cells the memory had
 #: seen free: something came where there was nothing). At MOVE_DISTANCE alone, a walker
 #: at the robot's top speed was known to move 1.4 s after it was first seen (0.8 s with
-#: this), too late to get out of its way (arena_003, clutter_walkers_011 of the moving suite:
-#: README, "Moving-obstacle suite"); at this distance for every track, a static
-#: cluster in a BARN world moved and its gap closed (barn_014).
+#: this), too late to get out of its way; at this distance for every track, static
+#: clutter seemed to move and the gaps between it closed (docs/moving_obstacles.md).
 NEW_MOVE_DISTANCE = 0.15
 #: A cluster whose points lie this close to a line [m] (the smaller principal standard
 #: deviation), and that is longer than THIN_LENGTH [m], is a piece of wall: a wall seen

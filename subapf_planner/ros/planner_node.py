@@ -190,8 +190,7 @@ class PlannerNode(Node):
             self.timer.timer_period_ns = int(cfg.period * 1e9)
         self.options = pending[NodeOptions]
         self.intake = self._intake()
-        self.ctl.cfg = self._mounted(cfg)
-        self.ctl.limits = pending[Supervision]
+        self.ctl.reconfigure(self._mounted(cfg), pending[Supervision])
 
     # --- the laser mounting from /tf_static --------------------------------------------
     def _setup_tf_static(self) -> None:
@@ -222,7 +221,7 @@ class PlannerNode(Node):
                                    f'mounting kept from parameters {self.ctl.cfg.laser_mount}')
             return
         self._tf_mount = mount
-        self.ctl.cfg = self._mounted(self.ctl.cfg)
+        self.ctl.reconfigure(self._mounted(self.ctl.cfg))
         self.get_logger().info(
             f'laser mounting from /tf_static ({o.base_frame} -> {o.laser_frame}): '
             f'x={mount[0]:.3f} m y={mount[1]:.3f} m yaw={mount[2]:.3f} rad '
@@ -337,7 +336,7 @@ class PlannerNode(Node):
                 result, self.options.odom_frame, tick.to_msg(), cfg.danger_distance,
                 cfg.robot_radius, cfg.voxel_size))
         if cfg.geodesic and listened(self.correction_pub):   # with the tick's scan matched
-            correction = self.ctl.planner.correction
+            correction = self.ctl.correction
             self.correction_pub.publish(transform_msg(
                 self.options.map_frame, self.options.odom_frame,
                 (*correction[:2], 0.0), correction[2], now))
@@ -350,7 +349,7 @@ class PlannerNode(Node):
         frame, now = self.options.odom_frame, tick.nanoseconds * 1e-9
         result = decision.result
         field = result.field if result is not None else None
-        memory_frame = invert(self.ctl.planner.correction)   # its pose in odom
+        memory_frame = invert(self.ctl.correction)   # its pose in odom
         if self.options.publish_plan and field is not None and result.pose is not None \
                 and listened(self.plan_pub):
             here = result.pose[:2]

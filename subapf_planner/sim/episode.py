@@ -61,7 +61,7 @@ class EpisodeResult:
         return int(self.plan_ms.size)
 
     def metrics(self, world: World) -> dict[str, float | int | str]:
-        """The results.json record of this run (see README 'Benchmark')."""
+        """The results.json record of this run (docs/results.md)."""
         return {
             'world': self.world,
             'method': self.method,
@@ -121,7 +121,7 @@ def run_episode(world: World, cfg: PlannerConfig, sim_cfg: SimConfig | None = No
                 plan_ms.append((time.perf_counter() - t0) * 1e3)
                 recomputed.append(decision.result.new_field)
                 if decision.result.new_field:
-                    field_ms.append(ctl.planner.memory.compute_seconds * 1e3)
+                    field_ms.append(ctl.field_seconds * 1e3)
             key = str(decision.result.command.status) if decision.result is not None \
                 else decision.text
             statuses[key] = statuses.get(key, 0) + 1

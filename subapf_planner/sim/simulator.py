@@ -63,7 +63,7 @@ class SimConfig:
     physics_dt: float = param(0.005, 'Physics time step', 's', 1e-4, 0.05, read_only=True)
     solver_iterations: int = param(50, "PyBullet's constraint-solver iterations per physics "
                                    'step (its default, 50; fewer is faster and the wheels '
-                                   'slip differently: README, Performance)', '', 1, 500,
+                                   'slip differently: docs/performance.md)', '', 1, 500,
                                    read_only=True)
     scan_threads: int = param(0, "Threads PyBullet's rayTestBatch casts a sweep's beams on "
                               '(0: all cores; the ranges are the same for any number: '

@@ -8,6 +8,8 @@ workers of a Dask distributed cluster (the same results.json but the timings).
 Writes ``results.json``, ``summary.md`` and the PNGs to --out. One parameter file (default: the
 package's config/planner.yaml) for all worlds; a method may name its attraction
 field (``subharmonic_sampling:euclidean`` is the paper's method exactly).
+results.json's ``meta`` says how it was produced (command line, package version, git
+commit, date): ``subapf-results`` puts it under the tables of docs/results.md.
 """
 
 from __future__ import annotations
@@ -17,9 +19,14 @@ from collections.abc import Iterator
 from concurrent.futures import Executor, ProcessPoolExecutor
 import contextlib
 import dataclasses
+import datetime
+import importlib.metadata
 import json
 from pathlib import Path
+import re
+import shlex
 import statistics
+import subprocess
 import sys
 import time
 
@@ -195,6 +202,53 @@ def summarise(runs: list[dict], methods: list[str]) -> str:
     return '\n'.join(lines) + '\n'
 
 
+def _git(*args: str) -> str | None:
+    """A git command's output in this package's directory; None when it fails."""
+    try:
+        done = subprocess.run(['git', *args], cwd=Path(__file__).resolve().parent,
+                              capture_output=True, text=True, timeout=10, check=False)
+    except (OSError, subprocess.SubprocessError):
+        return None
+    return done.stdout.strip() if done.returncode == 0 else None
+
+
+def git_commit() -> str | None:
+    """The short commit the package runs from, with ``-dirty`` when tracked files have
+    changes; None when it is not run from a git checkout (an installed wheel, or a
+    directory inside some other repository)."""
+    top = _git('rev-parse', '--show-toplevel')
+    if top is None or Path(top).resolve() != Path(__file__).resolve().parents[2]:
+        return None
+    commit = _git('rev-parse', '--short', 'HEAD')
+    if commit is None:
+        return None
+    changes = _git('status', '--porcelain', '--untracked-files=no')
+    return commit + '-dirty' if changes else commit
+
+
+def package_version(checkout: bool) -> str | None:
+    """The version of the code that runs: in a git checkout its setup.py's (an editable
+    install's metadata keeps the version it was installed with), else the installed
+    distribution's."""
+    if checkout:
+        setup_py = Path(__file__).resolve().parents[2] / 'setup.py'
+        found = re.search(r"""^\s*version=['"]([^'"]+)['"]""", setup_py.read_text(), re.M)
+        if found:
+            return found.group(1)
+    try:
+        return importlib.metadata.version('subapf_planner')
+    except importlib.metadata.PackageNotFoundError:
+        return None
+
+
+def provenance(argv: list[str]) -> dict:
+    """results.json's ``meta``: how it was produced."""
+    commit = git_commit()
+    return {'command': 'subapf-bench ' + shlex.join(argv),
+            'version': package_version(commit is not None), 'commit': commit,
+            'date': datetime.date.today().isoformat()}
+
+
 def parse_args(argv: list[str] | None) -> argparse.Namespace:
     p = argparse.ArgumentParser(prog='subapf-bench', description=__doc__.splitlines()[0])
     p.add_argument('worlds', nargs='*', help='world files or directories (default: shipped)')
@@ -227,6 +281,7 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
 
 
 def main(argv: list[str] | None = None) -> int:
+    argv = sys.argv[1:] if argv is None else list(argv)
     args = parse_args(argv)
     try:
         methods = [m.strip() for m in args.methods.split(',') if m.strip()]
@@ -270,7 +325,8 @@ def main(argv: list[str] | None = None) -> int:
     wall = time.perf_counter() - t0
     runs = [r for world_runs in per_world for r, _ in world_runs]
     labels = list(dict.fromkeys(r['method'] for r in runs))
-    doc = {'runs': runs, 'methods': labels, 'seed': args.seed, 'noise': args.noise,
+    doc = {'meta': provenance(argv),
+           'runs': runs, 'methods': labels, 'seed': args.seed, 'noise': args.noise,
            'beam_dropout': args.beam_dropout, 'scan_dropout': args.scan_dropout,
            'scan_latency': args.scan_latency, 'odom_distance_scale': args.odom_scale,
            'odom_yaw_scale': args.odom_yaw_scale, 'wall_time_s': round(wall, 2),

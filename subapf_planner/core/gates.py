@@ -1,0 +1,125 @@
+"""Gates: the stages that may stop a cycle before anything is planned (core/cycle.py).
+
+In the order :func:`~subapf_planner.core.pipeline.stage_names` runs them:
+
+* ``goal``: the goal reached (within ``goal_tolerance``; with the memory, once the
+  approach is over: see :class:`Goal`) or inside an obstacle (a laser point within
+  ``robot_radius`` of it);
+* ``mapping`` (with the scan alignment): the robot stands until the memory holds its
+  first scans, so that the memory's frame is odom at the start;
+* ``reachability`` (with the memory): the navigation field to the goal, and
+  ``goal_unreachable`` when the memory holds no way to it.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from .config import PlannerConfig
+from .cycle import Cycle, Stage
+from .memory import NavigationMemory
+from .sampling import clearance
+from .status import Status
+
+#: With the scan alignment, the robot stands until the memory holds this many scans
+#: (the occupancy grid's walls are established by three hits), for this many cycles at
+#: most (a scan repeated with the same stamp is not taken twice).
+FIRST_SCANS = 3
+#: Inside goal_tolerance, a cycle that brings the robot less than this closer to the goal
+#: ends the approach (it cannot get closer: arrival_distance) [m]; a tenth of the
+#: distance the burger drives in one 0.2 s period at its slowest approach speed.
+ARRIVAL_PROGRESS = 0.002
+
+
+def input_status(pose: ArrayLike, goal: ArrayLike) -> Status | None:
+    """``invalid_pose`` for a pose that is not three finite numbers (x, y, yaw),
+    ``invalid_goal`` for a goal that is not two; None when both are fine."""
+    if np.shape(pose) != (3,) or not all(math.isfinite(v) for v in pose):
+        return Status.INVALID_POSE
+    if np.shape(goal) != (2,) or not all(math.isfinite(v) for v in goal):
+        return Status.INVALID_GOAL
+    return None
+
+
+def goal_status(cfg: PlannerConfig, goal_distance: float, goal: NDArray[np.float64],
+                obstacles: NDArray[np.float64]) -> Status | None:
+    """``reached`` within goal_tolerance of the goal, ``goal_in_obstacle`` when a laser
+    point lies within robot_radius of it (the robot could not stand there); None
+    otherwise."""
+    if goal_distance <= cfg.goal_tolerance:
+        return Status.REACHED
+    if float(clearance(goal, obstacles)[0]) < cfg.robot_radius:
+        return Status.GOAL_IN_OBSTACLE
+    return None
+
+
+class Goal(Stage):
+    """``reached`` or ``goal_in_obstacle`` (:func:`goal_status`). With the memory, the
+    approach goes on inside goal_tolerance while the robot is farther than
+    ``arrival_distance`` and each cycle brings it at least ARRIVAL_PROGRESS closer (a
+    pose error of a few centimetres still leaves it inside the tolerance)."""
+
+    name = 'goal'
+
+    def __init__(self) -> None:
+        self._approach: tuple[NDArray, float] | None = None   # last cycle's goal, distance
+
+    def forget(self) -> None:
+        self._approach = None
+
+    def run(self, cycle: Cycle) -> Cycle:
+        status = goal_status(cycle.cfg, cycle.goal_distance, cycle.goal, cycle.obstacles)
+        if status is Status.REACHED and self.drives_on(cycle):
+            status = None
+        self._approach = (cycle.goal, cycle.goal_distance)
+        return cycle.with_(status=status)
+
+    def drives_on(self, cycle: Cycle) -> bool:
+        """Inside goal_tolerance: whether to drive on (geodesic only; see the class)."""
+        cfg, distance = cycle.cfg, cycle.goal_distance
+        if not cfg.geodesic or distance <= cfg.arrival_distance:
+            return False
+        if self._approach is None or not np.array_equal(self._approach[0], cycle.goal):
+            return True
+        before = self._approach[1]
+        return before > cfg.goal_tolerance or before - distance >= ARRIVAL_PROGRESS
+
+
+class Mapping(Stage):
+    """``mapping`` while the memory holds fewer than FIRST_SCANS scans, for FIRST_SCANS
+    cycles at most; not once the robot is inside the goal tolerance."""
+
+    name = 'mapping'
+
+    def __init__(self) -> None:
+        self._cycles = 0   # cycles stood so far
+
+    def forget(self) -> None:
+        self._cycles = 0
+
+    def run(self, cycle: Cycle) -> Cycle:
+        if cycle.goal_distance <= cycle.cfg.goal_tolerance \
+                or cycle.memory_scans >= FIRST_SCANS or self._cycles >= FIRST_SCANS:
+            return cycle
+        self._cycles += 1
+        return cycle.with_(status=Status.MAPPING)
+
+
+class Reachability(Stage):
+    """The navigation field to the goal through the memory (core/memory.py);
+    ``goal_unreachable`` when there is none or the robot's position has no value in it
+    (no way)."""
+
+    name = 'reachability'
+
+    def __init__(self, memory: NavigationMemory) -> None:
+        self.memory = memory
+
+    def run(self, cycle: Cycle) -> Cycle:
+        field, new = self.memory.field_for(cycle.pose[:2], cycle.goal, cycle.now)
+        status = None if field is not None and field.reachable(cycle.pose[:2]) \
+            else Status.GOAL_UNREACHABLE
+        return cycle.with_(field=field, new_field=new, status=status)

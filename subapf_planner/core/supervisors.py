@@ -1,0 +1,205 @@
+"""Supervisors: the decision loop's stages around the planning step (core/loop.py).
+
+Each tick runs them in this order; the first that decides ends the tick:
+
+* before the planning step (``before``: may decide without planning):
+  ``goal`` (no goal: idle), ``inputs`` (no scan or odometry yet: waiting),
+  ``freshness`` (a scan older than ``scan_timeout`` or odometry older than
+  ``odom_timeout``: stopped), ``given_up`` (a goal given up stays given up until it
+  is sent again);
+* after it (``after``: may decide from the plan): ``arrival`` (``reached``: the goal
+  is done), ``unreachable`` (no way to the goal, or the goal inside an obstacle, for
+  ``unreachable_timeout``: given up), ``progress`` (the progress checker: no
+  ``progress_distance`` in ``progress_timeout`` starts a recovery (core/recovery.py),
+  at most ``recoveries`` times a goal, then gives the goal up as stuck; it waits while
+  a moving obstacle is within ``giving_way_distance``).
+
+What no supervisor decides, the plan does: a command that stops the robot is
+``stopped``, any other ``driving``. A supervisor keeps its own clock (``reset`` for a
+new goal, ``restart`` after a clock jump).
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from .cycle import PlanResult
+from .recovery import AvoidAhead
+from .status import State, Status
+
+if TYPE_CHECKING:
+    from .loop import Decision, DecisionLoop
+
+#: Statuses under which the goal cannot be reached for now; unreachable_timeout of them
+#: ends the attempt.
+NO_WAY = (Status.GOAL_UNREACHABLE, Status.GOAL_IN_OBSTACLE)
+
+
+class Supervisor:
+    """A stage of the decision loop's tick (module docstring); by default it decides
+    nothing and keeps nothing."""
+
+    name = 'supervisor'
+
+    def before(self, loop: DecisionLoop, now: float) -> Decision | None:
+        return None
+
+    def after(self, loop: DecisionLoop, result: PlanResult, now: float) -> Decision | None:
+        return None
+
+    def reset(self) -> None:
+        """A new goal."""
+        self.restart()
+
+    def restart(self) -> None:
+        """The clock jumped: forget the times kept."""
+
+
+class NoGoal(Supervisor):
+    name = 'goal'
+
+    def before(self, loop: DecisionLoop, now: float) -> Decision | None:
+        if loop.goal is None:
+            return loop.decide(None, State.IDLE, 'no goal')
+        return None
+
+
+class Inputs(Supervisor):
+    name = 'inputs'
+
+    def before(self, loop: DecisionLoop, now: float) -> Decision | None:
+        if loop.scan is None or loop.pose is None:
+            return loop.decide(None, State.WAITING,
+                               f'no {"scan" if loop.scan is None else "odom"} yet')
+        return None
+
+
+class Freshness(Supervisor):
+    name = 'freshness'
+
+    def before(self, loop: DecisionLoop, now: float) -> Decision | None:
+        scan_silent, odom_silent = loop.silent(now)
+        if scan_silent:
+            return loop.stop(State.STOPPED, 'scan is stale')
+        if odom_silent:
+            return loop.stop(State.STOPPED, 'odometry is stale')
+        return None
+
+
+class GivenUp(Supervisor):
+    name = 'given_up'
+
+    def before(self, loop: DecisionLoop, now: float) -> Decision | None:
+        if loop.state.gave_up:
+            return loop.hold()
+        return None
+
+
+class Arrival(Supervisor):
+    name = 'arrival'
+
+    def after(self, loop: DecisionLoop, result: PlanResult, now: float) -> Decision | None:
+        if result.command.status is Status.REACHED:
+            loop.clear_goal()
+            return loop.stop(State.REACHED, 'goal within tolerance', result)
+        return None
+
+
+class Unreachable(Supervisor):
+    """Gives the goal up once NO_WAY has lasted longer than unreachable_timeout (any
+    other status restarts the clock: a door that opens, someone who walked off)."""
+
+    name = 'unreachable'
+
+    def __init__(self) -> None:
+        self._since: float | None = None
+
+    def restart(self) -> None:
+        self._since = None
+
+    def after(self, loop: DecisionLoop, result: PlanResult, now: float) -> Decision | None:
+        if result.command.status not in NO_WAY:
+            self._since = None
+            return None
+        if self._since is None:
+            self._since = now
+        timeout = loop.limits.unreachable_timeout
+        if now - self._since <= timeout:
+            return None
+        tried = loop.recoveries.tried
+        return loop.stop(State.UNREACHABLE, f'no way to the goal for {timeout:g} s'
+                         f'{f" (every way tried: {tried})" if tried else ""}, goal abandoned',
+                         result)
+
+
+class Recoveries:
+    """The recoveries of one goal (core/recovery.py) and how many were tried."""
+
+    def __init__(self) -> None:
+        self.behaviours = (AvoidAhead(),)
+        self.tried = 0
+
+    def attempt(self, loop: DecisionLoop, now: float) -> bool:
+        """Run the next recovery, if any is left for this goal and one applies."""
+        lim = loop.limits
+        if self.tried >= lim.recoveries:
+            return False
+        planner = loop.planner
+        for behaviour in self.behaviours:
+            if behaviour.run(planner.memory, planner.planned_from, lim.avoid_distance,
+                             lim.avoid_radius, now + lim.avoid_time):
+                self.tried += 1
+                return True
+        return False
+
+
+class Progress(Supervisor):
+    """The progress checker (module docstring)."""
+
+    name = 'progress'
+
+    def __init__(self) -> None:
+        self._anchor: tuple[np.ndarray, float] | None = None   # where and when it last moved
+
+    def restart(self) -> None:
+        self._anchor = None
+
+    def after(self, loop: DecisionLoop, result: PlanResult, now: float) -> Decision | None:
+        cmd = result.command
+        if giving_way(result, loop.pose, loop.limits.giving_way_distance):
+            self._anchor = None
+        if cmd.status.stops and cmd.status is not Status.NO_SAFE_MOVE:
+            return None   # stopped for a reason of its own: not the progress checker's
+        self._move_anchor(loop.pose, loop.limits.progress_distance, now)
+        if now - self._anchor[1] <= loop.limits.progress_timeout:
+            return None
+        command = (0.0, 0.0) if cmd.status.stops else (cmd.v, cmd.w)   # (standing at a gap)
+        if loop.recoveries.attempt(loop, now):
+            self._anchor = None
+            tried, most = loop.recoveries.tried, loop.limits.recoveries
+            return loop.decide(command, State.DRIVING, f'no progress: the way ahead marked '
+                               f'tried ({tried} of {most}), another way', result)
+        return loop.stop(State.STUCK, 'no progress, goal abandoned', result)
+
+    def _move_anchor(self, pose: np.ndarray, distance: float, now: float) -> None:
+        """Start the clock anew where the robot is when it has none or has moved
+        ``distance`` [m] from where it started."""
+        if self._anchor is None or np.hypot(*(pose[:2] - self._anchor[0])) >= distance:
+            self._anchor = (pose[:2].copy(), now)
+
+
+def giving_way(result: PlanResult, pose: np.ndarray, distance: float) -> bool:
+    """A moving track is within ``distance`` [m] of the robot (at ``pose`` in odom, or
+    the result's own pose: the tracks are in the memory's frame): giving way to someone
+    is not being stuck."""
+    t = result.tracks
+    if not np.any(t.moving):
+        return False
+    pose = pose if result.pose is None else result.pose
+    return bool(np.min(np.hypot(*(t.position[t.moving] - pose[:2]).T)) < distance)
+
+
+#: The supervisors of every tick, in order (module docstring).
+SUPERVISORS = (NoGoal, Inputs, Freshness, GivenUp, Arrival, Unreachable, Progress)
