@@ -69,7 +69,7 @@ if ROS_BUILD:
 
 setup(
     name=PACKAGE,
-    version='0.8.0',
+    version='0.9.0',
     packages=find_packages(exclude=['test']),
     package_data={PACKAGE + '.sim': ['urdf/*.urdf']},
     data_files=[

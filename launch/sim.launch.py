@@ -1,10 +1,12 @@
 """The headless simulator and the planner on its clock:
 ``ros2 launch subapf_planner sim.launch.py world:=<world file> rate:=1.0``.
 
-sim_node (the PyBullet burger stand-in) publishes /clock, scan, odom and the run's
+sim_node (the PyBullet burger stand-in) publishes /clock, scan, odom and each goal's
 outcome; planner.launch.py's planner runs on that clock with the burger's config (the
-stand-in is a burger). Send a goal on goal_pose (RViz "2D Goal Pose", frame odom);
-subapf-bringup does all this in one process tree and sends the world's goal itself.
+stand-in is a burger). Send goals on goal_pose (RViz "2D Goal Pose", frame odom), one
+after another: the simulator goes on after each outcome, and each goal has the world's
+time limit of its own. subapf-bringup does all this in one process tree for the
+world's goal alone.
 ``foxglove:=true`` also starts foxglove_node: the run served live to Foxglove on
 ws://127.0.0.1:<foxglove_port>.
 """

@@ -256,13 +256,19 @@ def test_package_version_is_the_newest_release():
     assert setup_version() == xml_version == newest
 
 
+def tables(text: str, first_header: str) -> list[str]:
+    """The Markdown tables of ``text`` whose header's first cell is ``first_header``."""
+    found = re.findall(r'^\|.*\|\n(?:\|.*\|\n?)+', text, re.M)
+    return [t for t in found if t.startswith(f'| {first_header} |')]
+
+
 def test_parameters_named_in_the_docs_exist():
-    """Every parameter in the README's and docs/parameters.md's tables is in
+    """Every parameter in the README's and docs/parameters.md's parameter tables is in
     config/planner.yaml."""
     doc = yaml.safe_load((REPO / 'config' / 'planner.yaml').read_text())
     known = {name for node in doc.values() for name in node['ros__parameters']}
-    tables = readme_section('## The planner node') + (REPO / 'docs' / 'parameters.md').read_text()
-    rows = re.findall(r'^\| ((?:`\w+`(?: / )?)+) \|', tables, re.M)
+    text = readme_section('## The planner node') + (REPO / 'docs' / 'parameters.md').read_text()
+    rows = re.findall(r'^\| ((?:`\w+`(?: / )?)+) \|', ''.join(tables(text, 'parameter')), re.M)
     named = {n for row in rows for n in re.findall(r'`(\w+)`', row)}
     assert len(named) > 50
     assert named <= known, named - known
@@ -275,3 +281,17 @@ def test_results_pages_are_what_subapf_results_writes():
     data = REPO / 'docs' / 'results' / 'data'
     assert main(['--check', '--data', str(data), '--out', str(REPO / 'docs' / 'results.md'),
                  '--readme', str(REPO / 'README.md')]) == 0
+
+
+def test_the_readme_state_table_is_the_state_enum():
+    """README "States": one row per State, in the enum's order, its final column
+    State.final; mapping documented as the normal first state."""
+    from subapf_planner.core.status import State
+    table, = tables(readme_section('## The planner node'), 'state')
+    rows = re.findall(r'^\| `(\w+)` \| (.+) \| (yes|no) \|$', table, re.M)
+    assert [(name, final == 'yes') for name, _, final in rows] == \
+        [(str(s), s.final) for s in State]
+    meaning = {name: text for name, text, _ in rows}
+    assert 'normal first state' in meaning['mapping']
+    assert {str(s) for s in State if s.final} == {'reached', 'stuck', 'unreachable'}
+

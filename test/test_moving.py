@@ -83,7 +83,7 @@ def test_interpolation_hold_loop_and_offset():
 def test_the_laser_sees_a_walker_where_its_path_puts_it():
     w = parse_world(doc({'circle': {'radius': 0.3}, 'path': [[0, 2.0, -3.0], [6, 2.0, 3.0]]},
                         goal=(0.0, 3.0)))
-    with BurgerSim(w, SimConfig(range_noise=0.0)) as sim:
+    with BurgerSim(w, SimConfig(sensor='ideal')) as sim:
         sim.step(3.0)   # the walker is at (2, 0), straight ahead of the laser
         scan = sim.scan()
     assert scan.ranges[0] == pytest.approx(2.0 - 0.3 + 0.032, abs=0.01)

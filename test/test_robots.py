@@ -34,6 +34,7 @@ def test_each_robot_file_configures_the_node(key):
         assert (options.base_frame, options.laser_frame) == (robot.base_frame,
                                                              robot.laser_frame)
         assert options.enable_stamped_cmd_vel == robot.stamped_cmd_vel
+        assert options.robot == key and options.robot_description is robot
         node.destroy_node()
     finally:
         rclpy.try_shutdown(context=context)

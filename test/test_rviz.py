@@ -101,7 +101,9 @@ def test_rviz_config_names_what_the_nodes_publish(tmp_path: Path):
         for topic, block in topics.items():
             if block['Class'] == 'rviz_default_plugins/SetGoal':   # RViz publishes it
                 subs = peer.get_subscriptions_info_by_topic(topic)
-                assert [s.topic_type for s in subs] == ['geometry_msgs/msg/PoseStamped']
+                # the planner and the simulator (which serves each new goal)
+                assert {s.topic_type for s in subs} == {'geometry_msgs/msg/PoseStamped'}
+                assert {s.node_name for s in subs} >= {'subapf_planner', 'subapf_sim'}, subs
                 continue
             pubs = peer.get_publishers_info_by_topic(topic)
             assert pubs, f'{topic}: nobody publishes it'

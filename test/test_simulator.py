@@ -38,7 +38,7 @@ def test_rotation_covers_w_times_t():
 
 def test_lidar_range_to_known_box():
     box = {'box': {'center': [2.0, 0.0], 'size': [0.2, 2.0]}}
-    with BurgerSim(world([box]), SimConfig(range_noise=0.0)) as sim:
+    with BurgerSim(world([box]), SimConfig(sensor='ideal')) as sim:
         scan = sim.scan()
     face = 2.0 - 0.1 - ROBOT.laser.x
     assert scan.ranges[0] == pytest.approx(face, abs=1e-3)
@@ -148,7 +148,7 @@ def test_scan_threads_change_the_speed_not_the_ranges():
     obstacles = [{'circle': {'center': [float(x), float(y)], 'radius': 0.2}}
                  for x, y in rng.uniform(-3.0, 3.0, (25, 2)) if math.hypot(x, y) > 0.6]
     obstacles += [{'box': {'center': [0.0, 3.2], 'size': [6.0, 0.2], 'yaw': 0.3}}]
-    sims = [BurgerSim(world(obstacles), SimConfig(scan_threads=n, range_noise=0.0))
+    sims = [BurgerSim(world(obstacles), SimConfig(scan_threads=n, sensor='ideal'))
             for n in (1, 0)]
     try:
         for _ in range(12):

@@ -257,7 +257,8 @@ class Match:
 
 def _beside(points: NDArray[np.float64], near: NDArray[np.float64],
             normal: NDArray[np.float64], d: NDArray[np.float64],
-            resolution: float) -> NDArray[np.bool_]:
+            resolution: float, reach: NDArray[np.float64] | float = MAX_CORRESPONDENCE
+            ) -> NDArray[np.bool_]:
     """Which returns take part: those within MAX_CORRESPONDENCE of a wall and beside it,
     no more than ALONG_WALL cells from their nearest wall point along the wall. A return
     beyond the end of a wall the memory holds (the part ahead not yet established) has
@@ -265,7 +266,7 @@ def _beside(points: NDArray[np.float64], near: NDArray[np.float64],
     along the wall (a corridor's far end, a room's new wall)."""
     off = points - near
     along = np.abs(off[:, 0] * normal[:, 1] - off[:, 1] * normal[:, 0])
-    return (d <= MAX_CORRESPONDENCE) & (along <= ALONG_WALL * resolution)
+    return (d <= reach) & (along <= ALONG_WALL * resolution)
 
 
 def _extents(points: NDArray[np.float64], pieces: NDArray[np.int64]) -> NDArray[np.float64]:
@@ -286,18 +287,19 @@ def landmarks(points: NDArray[np.float64], pieces: NDArray[np.int64],
 
 
 def _taking_part(field: DistanceField, world: NDArray[np.float64],
-                 small: NDArray[np.bool_]) -> tuple[NDArray, NDArray, NDArray, NDArray]:
+                 small: NDArray[np.bool_], reach: NDArray[np.float64] | float
+                 = MAX_CORRESPONDENCE) -> tuple[NDArray, NDArray, NDArray, NDArray]:
     """For the returns at ``world`` (n, 2) [m]: the nearest wall point, the normal, the
     distance (DistanceField.lookup) and which take part: beside a wall (:func:`_beside`),
     and for those of ``small`` pieces, a wall that has stood (not young)."""
     near, normal, d, young = field.lookup(world)
-    use = _beside(world, near, normal, d, field.resolution) & ~(small & young)
+    use = _beside(world, near, normal, d, field.resolution, reach) & ~(small & young)
     return near, normal, d, use
 
 
 def align(base_points: NDArray[np.float64], predicted: NDArray[np.float64],
           field: DistanceField | None, pieces: NDArray[np.int64] | None = None,
-          mover_size: float = math.inf) -> Match:
+          mover_size: float = math.inf, noise: tuple[float, float] = (0.0, 0.0)) -> Match:
     """The pose of base_footprint that puts ``base_points`` (n, 2; the returns in
     base_footprint [m]) on the field's walls, starting from and drawn towards
     ``predicted`` (x, y, yaw); see the module docstring. With ``pieces`` (each point's
@@ -311,10 +313,16 @@ def align(base_points: NDArray[np.float64], predicted: NDArray[np.float64],
     small = np.zeros(len(base_points), bool) if pieces is None else \
         _extents(base_points, pieces)[pieces] <= mover_size
     pose = prior.copy()
-    w_ret = RETURN_SIGMA ** -2
+    # each return weighed by its range's noise (``noise``: the lidar's floor [m] and
+    # fraction of the range), on top of the map's own (RETURN_SIGMA); a noisy far
+    # return may lie farther from its wall
+    sigma = np.hypot(RETURN_SIGMA, np.maximum(noise[0], noise[1] * np.hypot(
+        *base_points.T)))
+    weight_all = sigma ** -2
+    reach = np.maximum(MAX_CORRESPONDENCE, 2.0 * sigma)
     for _ in range(ITERATIONS):
         world = to_parent(pose, base_points)
-        near, normal, d, use = _taking_part(field, world, small)
+        near, normal, d, use = _taking_part(field, world, small, reach)
         if np.count_nonzero(use) < MIN_MATCHED:
             return Match(prior, False, int(np.count_nonzero(use)), math.nan)
         c, s = math.cos(pose[2]), math.sin(pose[2])
@@ -325,15 +333,16 @@ def align(base_points: NDArray[np.float64], predicted: NDArray[np.float64],
         jac = np.column_stack((n[:, 0], n[:, 1], np.einsum('ij,ij->i', n, dyaw)))
         off = pose - prior
         off[2] = math.remainder(off[2], 2 * math.pi)
-        h = w_ret * jac.T @ jac + INFO_PRIOR
-        b = w_ret * jac.T @ res + INFO_PRIOR @ off
+        w_ret = weight_all[use]
+        h = (jac.T * w_ret) @ jac + INFO_PRIOR
+        b = (jac.T * w_ret) @ res + INFO_PRIOR @ off
         step = -np.linalg.solve(h, b)
         pose = pose + step
         if np.hypot(step[0], step[1]) < CONVERGED and abs(step[2]) < CONVERGED:
             break
     off = pose - prior
     off[2] = math.remainder(off[2], 2 * math.pi)
-    _, _, d, use = _taking_part(field, to_parent(pose, base_points), small)
+    _, _, d, use = _taking_part(field, to_parent(pose, base_points), small, reach)
     matched = int(np.count_nonzero(use))
     shift = float(np.hypot(off[0], off[1]))
     ok = matched >= MIN_MATCHED and shift <= MAX_STEP_XY and abs(off[2]) <= MAX_STEP_YAW

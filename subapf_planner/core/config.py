@@ -152,6 +152,16 @@ class PlannerConfig:
                                  'and the memory, the field and the goal live in the '
                                  'corrected frame (with the geodesic attraction; '
                                  'docs/alignment.md). Switching it starts an empty map')
+    alignment_gain: float = param(1.0, "Fraction of an accepted match's correction taken "
+                                  "at each scan (below 1: the matcher's noise averaged "
+                                  'over several scans)', '', 0.01, 1.0)
+    range_noise_floor: float = param(0.0075, "The lidar's range noise (standard deviation) "
+                                     'near it: the scan alignment weighs each return by '
+                                     'its noise (LDS-01: +/-15 mm below 0.5 m, taken as '
+                                     '2 sigma)', 'm', 0.0, 1.0)
+    range_noise_fraction: float = param(0.025, '... and as a fraction of the range farther '
+                                        'out (LDS-01: +/-5 % from 0.5 to 3.5 m, 2 sigma)',
+                                        '', 0.0, 1.0)
     # --- moving obstacles (core/tracking.py, core/evasion.py) ------------------------
     track_moving: bool = param(True, 'Track moving obstacles from the scans (clusters, '
                                'constant-velocity Kalman filters): their points stay out of '
@@ -265,6 +275,53 @@ def robot_fields(robot: RobotDescription) -> dict[str, float]:
         'max_linear_velocity': robot.max_linear_velocity,
         'reverse_speed': robot.max_linear_velocity,
         'max_angular_velocity': robot.max_angular_velocity}
+
+
+#: The PlannerConfig limits bounded by what the robot can do: field -> the
+#: RobotDescription attribute that bounds it (robot_limits).
+ROBOT_LIMITS = {
+    'max_linear_velocity': 'max_linear_velocity',
+    'reverse_speed': 'max_linear_velocity',
+    'max_angular_velocity': 'max_angular_velocity',
+    'max_linear_acceleration': 'max_linear_acceleration',
+    'max_angular_acceleration': 'max_angular_acceleration',
+}
+
+
+def beyond_robot(cfg: PlannerConfig, robot: RobotDescription
+                 ) -> list[tuple[str, float, float]]:
+    """(field, its value, the robot's limit) of each limit of ``cfg`` above what ``robot``
+    can do (ROBOT_LIMITS; a limit the description does not state is not checked)."""
+    out = []
+    for name, attr in ROBOT_LIMITS.items():
+        limit = getattr(robot, attr)
+        value = getattr(cfg, name)
+        if limit is not None and value > limit + 1e-9:
+            out.append((name, value, limit))
+    return out
+
+
+def beyond_robot_text(name: str, value: float, limit: float, robot: RobotDescription) -> str:
+    """One line naming a limit, its value and the robot's."""
+    unit = _unit(name)
+    return (f'{name}: {value:g} {unit} is beyond what the {robot.name} can do '
+            f'({limit:g} {unit}, core/robot.py)')
+
+
+def _unit(name: str) -> str:
+    return PlannerConfig.__dataclass_fields__[name].metadata['unit']
+
+
+def clamp_to_robot(cfg: PlannerConfig, robot: RobotDescription
+                   ) -> tuple[PlannerConfig, list[str]]:
+    """``cfg`` with each limit beyond what ``robot`` can do set to the robot's, and one
+    line per limit clamped naming both numbers."""
+    beyond = beyond_robot(cfg, robot)
+    if not beyond:
+        return cfg, []
+    notes = [f'{beyond_robot_text(name, value, limit, robot)}: clamped to {limit:g} '
+             f'{_unit(name)}' for name, value, limit in beyond]
+    return cfg.replace(**{name: limit for name, _, limit in beyond}), notes
 
 
 def field_specs() -> list[dataclasses.Field]:

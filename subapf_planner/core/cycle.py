@@ -78,12 +78,15 @@ class Cycle:
     obstacles: NDArray[np.float64]
     nearest_distance: float
     goal_distance: float
-    #: The moving-obstacle tracks of this scan (NO_TRACKS without the tracker).
+    #: The moving-obstacle tracks of this scan (NO_TRACKS without the tracker), where
+    #: they were when it was taken.
     tracks: Tracks
     #: The last command (v, w): the acceleration limits start from it.
     previous: tuple[float, float]
     #: Scans in the memory, this cycle's counted (0 without the memory).
     memory_scans: int = 0
+    #: How old the scan is [s] (now minus its stamp; 0 when unknown).
+    scan_age: float = 0.0
     #: The navigation field (None: the Euclidean attraction) and whether it is new.
     field: NavigationField | None = None
     new_field: bool = False

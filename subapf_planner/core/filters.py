@@ -2,9 +2,10 @@
 it (core/cycle.py).
 
 * ``evasion`` (with the tracker, for the APF methods): the command is rolled out
-  against where the moving tracks will be and replaced by an escape when it would
-  meet one (core/evasion.py); the chosen escape is committed, so the next cycle
-  weighs it again one period on. Not once the goal is reached.
+  against where the moving tracks will be (carried forward from the scan's time to
+  the cycle's) and replaced by an escape when it would meet one (core/evasion.py);
+  the chosen escape is committed, so the next cycle weighs it again one period on.
+  Not once the goal is reached.
 """
 
 from __future__ import annotations
@@ -17,6 +18,10 @@ from .command import Command, forward_blocked
 from .cycle import Cycle, Stage
 from .evasion import Escape, evade
 from .status import Status
+
+#: The tracks are carried forward to the cycle's time by at most this [s] (a scan older
+#: than the scan timeout stops the robot anyway).
+MAX_AGE = 1.0
 
 
 class Evasion(Stage):
@@ -37,7 +42,8 @@ class Evasion(Stage):
             return cycle
         cfg, pose, points = cycle.cfg, cycle.pose, cycle.points
         cmd = result.command
-        alt = evade(pose, (cmd.v, cmd.w), tracks, points[~tracks.moving_points], cfg,
+        alt = evade(pose, (cmd.v, cmd.w), tracks.ahead(min(cycle.scan_age, MAX_AGE)),
+                    points[~tracks.moving_points], cfg,
                     forward_blocked(pose, points, cfg),
                     None if self._escape is None else self._escape.advanced())
         self._escape = alt

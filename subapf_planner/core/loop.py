@@ -10,9 +10,10 @@ given up; then arrival, unreachable, progress with its recoveries) around one
 planning step (core/planner.py: perceive, then the cycle's stages).
 
 States (:class:`~.status.State`, the text of ``~/status`` before the colon):
-idle, waiting, driving, reached, stopped, stuck (the progress checker gave the
-goal up), unreachable (no way through the memory, or the goal inside an obstacle,
-for ``unreachable_timeout``).
+idle, waiting, mapping (the first scans of a new memory, taken standing: the normal
+start of a goal), driving, stopped, and the final ones, which stay until the next
+goal: reached, stuck (the progress checker gave the goal up), unreachable (no way
+through the memory, or the goal inside an obstacle, for ``unreachable_timeout``).
 """
 
 from __future__ import annotations
@@ -29,8 +30,9 @@ from .memory import SAME_GOAL
 from .occupancy import OccupancyGrid
 from .params import check_fields, param
 from .planner import Planner
-from .scan import Scan
-from .status import State
+from .robot import compose, invert
+from .scan import Scan, deskew
+from .status import State, Status
 from .supervisors import SUPERVISORS, Recoveries
 
 #: Odometry poses kept to place each scan at the pose it was taken from.
@@ -109,6 +111,7 @@ class DecisionLoop:
         self.state = State.IDLE
         self.reason = 'no goal'
         self.supervisors = tuple(cls() for cls in SUPERVISORS)
+        self._deskew: tuple[Scan, Scan] | None = None   # the last scan, and deskewed
         self.recoveries = Recoveries()
 
     @property
@@ -164,12 +167,14 @@ class DecisionLoop:
 
     def set_goal(self, goal: np.ndarray, in_map: bool = False) -> bool:
         """A new goal resets the planner; the goal being driven to (or waited for: no
-        inputs yet), sent again, does not, whenever it arrives (a stuck or stopped robot
-        retries it). Returns whether the goal was new. ``goal`` (x, y) is in odom (the
-        place odom puts there now), or with ``in_map`` in the memory's frame (the place
-        in the world, as odom was at the start: what the scan alignment keeps still)."""
+        inputs yet; or stood for: mapping), sent again, does not, whenever it arrives (a
+        stuck, stopped or arrived robot retries it). Returns whether the goal was new.
+        ``goal`` (x, y) is in odom (the place odom puts there now), or with ``in_map`` in
+        the memory's frame (the place in the world, as odom was at the start: what the
+        scan alignment keeps still)."""
         goal = np.asarray(goal, float)
-        if self.goal is not None and self.state in (State.DRIVING, State.WAITING) \
+        if self.goal is not None \
+                and self.state in (State.DRIVING, State.WAITING, State.MAPPING) \
                 and np.hypot(*(goal - self.goal)) < SAME_GOAL \
                 and in_map == self.goal_in_map:
             return False
@@ -222,6 +227,42 @@ class DecisionLoop:
                 best, nearest = gap, pose
         return nearest if best <= POSE_MATCH else self.pose
 
+    def pose_between(self, stamp: float) -> np.ndarray:
+        """The odometry pose at ``stamp`` [s], interpolated between the two poses around
+        it (the oldest or the newest beyond them)."""
+        poses = self.poses
+        if not poses:
+            return self.pose
+        if stamp <= poses[0][0]:
+            return poses[0][1]
+        for (t0, p0), (t1, p1) in zip(reversed(list(poses)[:-1]), reversed(poses),
+                                      strict=False):
+            if t0 <= stamp <= t1:
+                f = 0.0 if t1 <= t0 else (stamp - t0) / (t1 - t0)
+                dyaw = math.remainder(p1[2] - p0[2], 2 * math.pi)
+                return np.array([p0[0] + f * (p1[0] - p0[0]), p0[1] + f * (p1[1] - p0[1]),
+                                 p0[2] + f * dyaw])
+            if t1 < stamp:
+                break
+        return poses[-1][1]
+
+    def sweep_motion(self, scan: Scan) -> np.ndarray:
+        """base_footprint's motion (x, y, yaw) from the scan's first beam to its last, in
+        its pose at the first, as odometry says (zero for a scan taken at once)."""
+        n = np.size(scan.ranges)
+        if scan.time_increment <= 0.0 or n < 2 or not math.isfinite(scan.stamp):
+            return np.zeros(3)
+        start = self.pose_between(scan.stamp)
+        end = self.pose_between(scan.stamp + (n - 1) * scan.time_increment)
+        return np.asarray(compose(invert(start), end))
+
+    def _deskewed(self, scan: Scan) -> Scan:
+        """The scan as if taken at its first beam's instant (core/scan.py deskew), once
+        per scan."""
+        if self._deskew is None or self._deskew[0] is not scan:
+            self._deskew = (scan, deskew(scan, self.sweep_motion(scan), self.cfg.laser_mount))
+        return self._deskew[1]
+
     def silent(self, now: float) -> tuple[bool, bool]:
         """Whether the scan, and the odometry, are silent at ``now`` [s]: none taken
         yet, or the newest older than scan_timeout (odom_timeout)."""
@@ -255,7 +296,7 @@ class DecisionLoop:
             decision = s.before(self, now)
             if decision is not None:
                 return decision
-        result = self.planner.step(self.pose, self.goal, self.scan,
+        result = self.planner.step(self.pose, self.goal, self._deskewed(self.scan),
                                    self.pose_at(self.scan.stamp), now=now,
                                    goal_in_map=self.goal_in_map)
         for s in self.supervisors:
@@ -264,5 +305,8 @@ class DecisionLoop:
                 return decision
         cmd = result.command
         if cmd.status.stops:
-            return self.stop(State.STOPPED, cmd.status, result)
+            # standing for the first scans of a new memory is the normal start of a goal,
+            # not a stop: its own state (the same zero command)
+            state = State.MAPPING if cmd.status is Status.MAPPING else State.STOPPED
+            return self.stop(state, cmd.status, result)
         return self.decide((cmd.v, cmd.w), State.DRIVING, cmd.status, result)

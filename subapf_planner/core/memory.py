@@ -217,7 +217,8 @@ class NavigationMemory:
                                             g.established_at, g.scans)
             self._distance_age = 0
         self._distance_age += 1
-        return align(base, pred, self._distance, pieces, self.cfg.max_mover_size)
+        return align(base, pred, self._distance, pieces, self.cfg.max_mover_size,
+                     (self.cfg.range_noise_floor, self.cfg.range_noise_fraction))
 
     def avoid(self, point: ArrayLike, radius: float, until: float) -> None:
         """Block the cells within ``radius`` [m] of ``point`` in the navigation field

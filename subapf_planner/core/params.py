@@ -11,6 +11,7 @@ the same metadata, and ``config/planner.yaml`` documents the same names
 from __future__ import annotations
 
 import dataclasses
+import difflib
 import math
 from typing import Any, Mapping, TypeVar
 
@@ -37,6 +38,26 @@ def kind_of(f: dataclasses.Field) -> type:
     """bool, int, float, str or tuple (of strings): the declared type of a field."""
     return {'bool': bool, 'int': int, 'float': float, 'str': str,
             'tuple[str, ...]': tuple}.get(f.type, f.type)
+
+
+def describe(f: dataclasses.Field) -> str:
+    """One sentence about a field: description [unit], choices or range, read-only (the
+    comment of config/planner.yaml, the nodes' --help)."""
+    m = f.metadata
+    text = m['description'] + (f' [{m["unit"]}]' if m['unit'] else '')
+    if m.get('choices'):
+        text += '; one of: ' + ', '.join(m['choices'])
+    elif m.get('lo') is not None:
+        text += f'; range [{m["lo"]}, {m["hi"]}]'
+    if m.get('read_only'):
+        text += '; read-only'
+    return text + '.'
+
+
+def closest_name(name: str, names: Any) -> str | None:
+    """The name among ``names`` closest to ``name`` (a misspelling), or None."""
+    close = difflib.get_close_matches(name, sorted(names), n=1, cutoff=0.75)
+    return close[0] if close else None
 
 
 def check_field(f: dataclasses.Field, value: Any) -> None:

@@ -221,6 +221,7 @@ class Planner:
         cycle = Cycle(cfg, now, cfg.period, pose, goal, points, tracks=tracks,
                       previous=self.previous,
                       memory_scans=self.memory.grid.scans + (self._perception is not None),
+                      scan_age=now - scan.stamp if math.isfinite(scan.stamp) else 0.0,
                       **_situation(pose, goal, points))
         result = self._run_stages(cycle)
         result = dataclasses.replace(result, pose=pose, correction=self.correction)
@@ -285,11 +286,16 @@ class Planner:
         predicted = self.in_map(scan_pose)
         self.match = self.memory.align(base, predicted, self._moving_discs(scan.stamp))
         last, self._aligned_from = self._aligned_from, scan_pose
-        if not self.match.accepted or last is None:
+        if last is None or not self.match.accepted:
             return
         moved = compose(invert(last), scan_pose)   # odometry's motion since the last scan
         pose = within_drift(predicted, self.match.pose, math.hypot(moved[0], moved[1]),
                             moved[2])
+        gain = self.cfg.alignment_gain
+        if gain < 1.0:
+            step = pose - predicted
+            step[2] = math.remainder(step[2], 2 * math.pi)
+            pose = predicted + gain * step
         if not np.array_equal(pose, predicted):
             self.correction = compose(pose, invert(scan_pose))
 

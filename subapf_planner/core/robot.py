@@ -60,6 +60,11 @@ class RobotDescription:
     stamped_cmd_vel: bool = True
     #: Where each number comes from.
     source: str = ''
+    #: Largest accelerations the robot can do [m/s^2, rad/s^2]; None: no source states
+    #: one (the shipped robots: their Nav2 configs' acceleration limits are tuning, not
+    #: the base's), and the planner's are then not checked against it.
+    max_linear_acceleration: float | None = None
+    max_angular_acceleration: float | None = None
 
     @property
     def clearance(self) -> float:

@@ -28,7 +28,9 @@ class Scan:
 
     ranges [m] (any value; see :func:`valid_beams`), beam i at ``angle_min + i *
     angle_increment`` [rad], valid returns in [range_min, range_max) [m], ``stamp``:
-    capture time [s] (NaN: unknown, every use of it is new).
+    capture time of beam 0 [s] (NaN: unknown, every use of it is new); beam i taken
+    ``i * time_increment`` [s] after it (0: all at once), a sweep every ``scan_time``
+    [s] (0: unknown), as sensor_msgs/LaserScan has them.
     """
 
     ranges: NDArray[np.float64]
@@ -37,6 +39,8 @@ class Scan:
     range_min: float
     range_max: float
     stamp: float = math.nan
+    time_increment: float = 0.0
+    scan_time: float = 0.0
 
     def check(self) -> None:
         """Raise ScanError for a non-finite geometry or an angle_increment <= 0 with more
@@ -90,6 +94,50 @@ def scan_to_points(scan: Scan, pose: ArrayLike, mount: ArrayLike = (0.0, 0.0, 0.
     # laser frame -> base frame -> odom frame
     in_laser = np.column_stack((rv * np.cos(a), rv * np.sin(a)))
     return to_parent(pose, to_parent(mount, in_laser))
+
+
+def deskew(scan: Scan, motion: ArrayLike, mount: ArrayLike = (0.0, 0.0, 0.0)) -> Scan:
+    """The scan as if every beam had been taken at its first beam's instant: ``motion``
+    (x, y, yaw) is base_footprint's motion from the first beam to the last, in its pose
+    at the first (from odometry); beam i, taken ``i * time_increment`` after the first,
+    is placed with the fraction i / (n - 1) of it (a constant twist over the sweep),
+    ``mount`` the laser in base_footprint. The returns keep their bins: each lands in
+    the bin of its direction from the laser at the first beam (the nearest return when
+    several land in one; a bin none lands in has no return, NaN: it clears no cell).
+    A scan taken all at once (time_increment 0), or with no motion, is returned as it
+    is. Beams with no return keep it."""
+    n = np.size(scan.ranges)
+    motion = np.asarray(motion, float)
+    if n < 2 or scan.time_increment <= 0.0 or not np.all(np.isfinite(motion)) \
+            or not np.any(motion):
+        return scan
+    scan.check()
+    r = np.asarray(scan.ranges, float).ravel()
+    hit = scan.valid()
+    f = np.arange(n)[hit] / (n - 1)
+    mx, my, myaw = (float(v) for v in mount)
+    # the laser at beam i in the laser's frame at the first beam: mount^-1 . m_i . mount,
+    # m_i = f_i * motion (base_footprint's motion so far)
+    th = f * motion[2]
+    px = f * motion[0] + np.cos(th) * mx - np.sin(th) * my - mx
+    py = f * motion[1] + np.sin(th) * mx + np.cos(th) * my - my
+    c0, s0 = math.cos(myaw), math.sin(myaw)
+    lx, ly = c0 * px + s0 * py, -s0 * px + c0 * py
+    a = scan.angles[hit] + th   # (the laser's yaw moved by as much as the base's)
+    ex, ey = lx + r[hit] * np.cos(a), ly + r[hit] * np.sin(a)
+    inc = scan.angle_increment
+    bins = np.rint(np.mod(np.arctan2(ey, ex) - scan.angle_min, 2.0 * math.pi) / inc
+                   ).astype(np.int64)
+    if n * inc >= 2.0 * math.pi - 0.5 * inc:
+        bins %= n                       # a full turn: the last bin is next to the first
+    keep = bins < n
+    dist = np.hypot(ex, ey)[keep]
+    bins = bins[keep]
+    out = np.where(hit, np.nan, r)   # returns re-binned below; no-return beams kept
+    order = np.argsort(-dist)   # nearest written last: it wins its bin
+    out[bins[order]] = dist[order]
+    return Scan(out, scan.angle_min, scan.angle_increment, scan.range_min, scan.range_max,
+                scan.stamp, 0.0, scan.scan_time)
 
 
 def geometry_warning(n: int, angle_min: float, angle_max: float,

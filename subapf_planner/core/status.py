@@ -2,6 +2,7 @@
 
 ``~/status`` carries ``"<State>: <reason>"``; a reason is a :class:`Status`
 (``driving: turning``) or a supervision reason (``stopped: scan is stale``).
+:func:`parse_status` turns the text back into the typed state and the reason.
 """
 
 from __future__ import annotations
@@ -41,13 +42,22 @@ STOP_STATUSES = frozenset({Status.NO_SAFE_MOVE, Status.GOAL_IN_OBSTACLE,
 
 
 class State(StrEnum):
-    """The planner node's state (core/loop.py), the text before the colon."""
+    """The planner node's state (core/loop.py), the text before the colon of
+    ``~/status``. The README's state table says what each means and which are final."""
 
+    #: No goal yet.
     IDLE = 'idle'
+    #: A goal, but no scan or no odometry yet.
     WAITING = 'waiting'
+    #: The normal first state of a goal with the scan alignment: the robot stands for the
+    #: first scans of a new memory (core/gates.py Mapping, FIRST_SCANS cycles at most).
+    MAPPING = 'mapping'
     DRIVING = 'driving'
-    REACHED = 'reached'
+    #: Held still for a reason that can pass (a stale input, no safe move, no way yet).
     STOPPED = 'stopped'
+    #: The goal is reached; stays until the next goal.
+    REACHED = 'reached'
+    #: The progress checker gave the goal up after its recoveries.
     STUCK = 'stuck'
     #: The goal was unreachable through the memory for ``unreachable_timeout``: given up.
     UNREACHABLE = 'unreachable'
@@ -61,6 +71,23 @@ class State(StrEnum):
     def gave_up(self) -> bool:
         """The attempt has ended without the goal (until a goal is sent again)."""
         return self in (State.STUCK, State.UNREACHABLE)
+
+    @property
+    def final(self) -> bool:
+        """The attempt at the goal is over (reached, or given up): the state stays until
+        the next goal, and nothing more happens for this one."""
+        return self in FINAL_STATES
+
+
+#: The states that end an attempt (State.final).
+FINAL_STATES = frozenset({State.REACHED, State.STUCK, State.UNREACHABLE})
+
+
+def parse_status(text: str) -> tuple[State, str]:
+    """The typed state and the reason of a ``~/status`` text ``"state: reason"``
+    (ValueError for a text that does not start with a state)."""
+    state, _, reason = text.partition(':')
+    return State(state.strip()), reason.strip()
 
 
 class Outcome(StrEnum):

@@ -3,7 +3,8 @@
 Each tick runs them in this order; the first that decides ends the tick:
 
 * before the planning step (``before``: may decide without planning):
-  ``goal`` (no goal: idle), ``inputs`` (no scan or odometry yet: waiting),
+  ``goal`` (no goal: idle, or still reached after the last one), ``inputs`` (no
+  scan or odometry yet: waiting),
   ``freshness`` (a scan older than ``scan_timeout`` or odometry older than
   ``odom_timeout``: stopped), ``given_up`` (a goal given up stays given up until it
   is sent again);
@@ -15,7 +16,8 @@ Each tick runs them in this order; the first that decides ends the tick:
   a moving obstacle is within ``giving_way_distance``).
 
 What no supervisor decides, the plan does: a command that stops the robot is
-``stopped``, any other ``driving``. A supervisor keeps its own clock (``reset`` for a
+``stopped`` (``mapping`` for the first scans of a new memory, taken standing), any
+other ``driving``. A supervisor keeps its own clock (``reset`` for a
 new goal, ``restart`` after a clock jump).
 """
 
@@ -62,6 +64,8 @@ class NoGoal(Supervisor):
 
     def before(self, loop: DecisionLoop, now: float) -> Decision | None:
         if loop.goal is None:
+            if loop.state is State.REACHED:   # a final state stays until the next goal
+                return loop.decide(None, State.REACHED, loop.reason)
             return loop.decide(None, State.IDLE, 'no goal')
         return None
 

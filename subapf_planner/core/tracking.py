@@ -122,6 +122,15 @@ class Tracks:
         """Per scan point: it belongs to a moving track."""
         return self._of_points(self.moving)
 
+    def ahead(self, dt: float) -> Tracks:
+        """The tracks ``dt`` [s] later: each where its velocity takes it (a scan is some
+        tenths of a second old when it is planned with: the sweep, the driver's latency,
+        the wait for the tick)."""
+        if dt <= 0.0 or not len(self.position):
+            return self
+        return Tracks(self.position + dt * self.velocity, self.velocity, self.radius,
+                      self.moving, self.held, self.point_track, self.trail)
+
     def predicted(self, t: float) -> NDArray[np.float64]:
         """Positions of the moving tracks ``t`` seconds ahead (k, 2) [m]."""
         return self.position[self.moving] + t * self.velocity[self.moving]

@@ -34,15 +34,21 @@ def seconds_to_stamp(t: float) -> Time:
 
 
 def scan_from_msg(msg: LaserScan) -> Scan:
-    """LaserScan -> Scan (stamp [s]). Its geometry is checked by the planner (Scan.check)."""
+    """LaserScan -> Scan (stamp [s]: its first beam's instant; time_increment, scan_time
+    as the driver gave them, a negative or non-finite one taken as 0: unknown). Its
+    geometry is checked by the planner (Scan.check)."""
+    def seconds(v: float) -> float:
+        return float(v) if math.isfinite(v) and v > 0.0 else 0.0
     return Scan(np.asarray(msg.ranges, dtype=float), float(msg.angle_min),
                 float(msg.angle_increment), float(msg.range_min), float(msg.range_max),
-                stamp_to_seconds(msg.header.stamp))
+                stamp_to_seconds(msg.header.stamp), seconds(msg.time_increment),
+                seconds(msg.scan_time))
 
 
 def scan_to_msg(scan: Scan, frame_id: str, scan_time: float = 0.2) -> LaserScan:
-    """Scan -> LaserScan in ``frame_id``, stamped with the scan's stamp; ``scan_time``
-    [s] is the sweep's duration (5 Hz: 0.2)."""
+    """Scan -> LaserScan in ``frame_id``, stamped with the scan's stamp (its first
+    beam's instant); its time_increment and scan_time, or for a scan taken at once
+    (time_increment 0) ``scan_time`` [s] (5 Hz: 0.2) and a time_increment of 0."""
     n = len(scan.ranges)
     msg = LaserScan()
     msg.header.stamp = seconds_to_stamp(scan.stamp)
@@ -52,8 +58,8 @@ def scan_to_msg(scan: Scan, frame_id: str, scan_time: float = 0.2) -> LaserScan:
     msg.angle_max = float(scan.angle_min + scan.angle_increment * (n - 1))
     msg.range_min = float(scan.range_min)
     msg.range_max = float(scan.range_max)
-    msg.scan_time = float(scan_time)
-    msg.time_increment = float(scan_time / max(n, 1))
+    msg.scan_time = float(scan.scan_time or scan_time)
+    msg.time_increment = float(scan.time_increment)
     msg.ranges = np.asarray(scan.ranges, dtype=np.float32).tolist()
     return msg
 

@@ -26,9 +26,10 @@ except ImportError:   # a Jazzy workspace without the pip line: a clear error at
 
 from ..bag.writer import RecorderError, message_definition
 from ..core.params import ConfigError, check_fields, param
-from .parameters import declare, read
+from .parameters import declare, read, warn_undeclared
 from .spinning import spin_node
 from .tap import TopicTap
+from .usage import node_usage
 
 #: Topics served by default (relative ones in the relay's namespace): what
 #: config/subapf.rviz shows, and the rest of a run.
@@ -56,12 +57,17 @@ class FoxgloveOptions:
             raise ConfigError('topics: no topic to serve')
 
 
+#: The parameter groups of the node with their titles (also config/planner.yaml's).
+SECTIONS = (('node (ros/foxglove_node.py)', FoxgloveOptions),)
+
+
 class FoxgloveNode(Node):
     """Serves ``topics`` over the Foxglove WebSocket protocol (see the module)."""
 
     def __init__(self, **kwargs) -> None:
         super().__init__('subapf_foxglove', **kwargs)
         declare(self, FoxgloveOptions)
+        warn_undeclared(self)
         options = read(self, FoxgloveOptions)
         if foxglove is None:
             raise ConfigError('the foxglove-sdk package is not installed '
@@ -116,8 +122,21 @@ class FoxgloveNode(Node):
         super().destroy_node()
 
 
+def usage() -> str:
+    """``subapf-foxglove --help``."""
+    return node_usage(
+        'subapf-foxglove', 'foxglove_node', 'subapf_foxglove', """
+        Serves the run live to Foxglove: a WebSocket server (foxglove-sdk) that relays the
+        planner's and the simulator's topics as they are on DDS (raw CDR with their
+        ros2msg schemas). In Foxglove: Open connection, Foxglove WebSocket,
+        ws://localhost:8765.
+
+        Example: subapf-foxglove --ros-args -p port:=8765""", SECTIONS)
+
+
 def main(args: list[str] | None = None) -> int:
-    return spin_node(FoxgloveNode, 'subapf-foxglove', (ConfigError,), args=args)
+    return spin_node(FoxgloveNode, 'subapf-foxglove', (ConfigError,), args=args,
+                     usage=usage)
 
 
 if __name__ == '__main__':

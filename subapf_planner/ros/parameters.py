@@ -4,7 +4,9 @@ Each node declares every field of its dataclasses with the field's default and
 a ParameterDescriptor (description with unit, range or choices, read-only),
 reads them back into validated dataclasses, and validates a run-time change by
 building the dataclasses with it: the descriptors, the YAML and the validation
-all come from one metadata source.
+all come from one metadata source. A value given for a name the node does not
+declare (a params file, ``-p``, the constructor's overrides) is reported with the
+closest declared name (``undeclared``), not dropped in silence.
 """
 
 from __future__ import annotations
@@ -15,7 +17,7 @@ from typing import Any, TypeVar
 from rcl_interfaces.msg import FloatingPointRange, IntegerRange, ParameterDescriptor
 from rclpy.node import Node
 
-from ..core.params import build, kind_of
+from ..core.params import build, closest_name, kind_of
 
 T = TypeVar('T')
 
@@ -50,3 +52,26 @@ def read(node: Node, cls: type[T], changes: dict[str, Any] | None = None) -> T:
     values = {f.name: node.get_parameter(f.name).value for f in dataclasses.fields(cls)}
     values.update({k: v for k, v in (changes or {}).items() if k in values})
     return build(cls, values)
+
+
+def undeclared(node: Node) -> list[str]:
+    """One line for each parameter value given to ``node`` (params files, ``-p``, the
+    constructor's parameter_overrides) under a name it has not declared: rclpy ignores
+    those; the line names the closest declared one. Call it once every parameter is
+    declared."""
+    known = set(node._parameters)
+    out = []
+    for name in sorted(set(node._parameter_overrides) - known):
+        close = closest_name(name, known)
+        hint = f'; did you mean {close!r}?' if close else '; see --help'
+        out.append(f'{name!r} is not a parameter of {node.get_name()}: its value is '
+                   f'ignored{hint}')
+    return out
+
+
+def warn_undeclared(node: Node) -> list[str]:
+    """Log ``undeclared(node)`` as warnings; returns them."""
+    lines = undeclared(node)
+    for line in lines:
+        node.get_logger().warn(line)
+    return lines

@@ -36,23 +36,31 @@ from rclpy.clock import JumpThreshold
 from rclpy.duration import Duration
 from rclpy.exceptions import ParameterException
 from rclpy.node import Node
+from rclpy.parameter import Parameter
 from rclpy.qos import QoSProfile, qos_profile_sensor_data
 from sensor_msgs.msg import LaserScan
 from std_msgs.msg import String
 from visualization_msgs.msg import MarkerArray
 
 from ..bag.events import stamp_ns
-from ..core.config import ConfigError, PlannerConfig
+from ..core.config import (
+    ConfigError,
+    PlannerConfig,
+    beyond_robot,
+    beyond_robot_text,
+    clamp_to_robot,
+)
 from ..core.loop import DecisionLoop, Supervision
 from ..core.navigation import thin_polyline
 from ..core.params import check_fields, param
-from ..core.robot import chain, invert, to_parent
+from ..core.robot import ROBOTS, RobotDescription, chain, invert, to_parent
 from .conversions import cmd_to_msg, grid_to_msg, path_to_msg, planar_transform, transform_msg
 from .intake import Intake
 from .markers import markers_from_result
-from .parameters import declare, read
+from .parameters import declare, read, warn_undeclared
 from .qos import LATCHED, listened, unheard_publishers
 from .spinning import PolledGroup, spin_node
+from .usage import node_usage
 
 NODE_NAME = 'subapf_planner'
 #: A forward clock jump longer than this, or any backward one, resets the inputs [s].
@@ -70,10 +78,19 @@ SILENCE_CHECK = 2.0
 ODOM_QUEUE = 50
 
 
+#: The value of the ``robot`` parameter for a robot of one's own (limits not checked).
+OTHER_ROBOT = 'other'
+
+
 @dataclass(frozen=True)
 class NodeOptions:
     """The planner node's own parameters (the rest: PlannerConfig and Supervision)."""
 
+    robot: str = param('burger', 'The robot (core/robot.py; config/robots/<robot>.yaml sets '
+                       'it): a velocity limit beyond what it can do is clamped to its own at '
+                       'start, with a warning, and refused at run time; other: a robot of '
+                       'your own, limits not checked', choices=(*ROBOTS, OTHER_ROBOT),
+                       read_only=True)
     goal_from_parameters: bool = param(False, 'Drive to (goal_x, goal_y) at start instead of '
                                        'waiting for goal_pose', read_only=True)
     goal_x: float = param(0.0, 'Goal x in odom_frame (with goal_from_parameters)', 'm',
@@ -107,9 +124,18 @@ class NodeOptions:
     def __post_init__(self) -> None:
         check_fields(self)
 
+    @property
+    def robot_description(self) -> RobotDescription | None:
+        """What the robot can do (None: a robot of one's own)."""
+        return ROBOTS.get(self.robot)
 
-#: The parameter groups of the node, in declaration order.
-GROUPS = (NodeOptions, Supervision, PlannerConfig)
+
+#: The parameter groups of the node with their titles, in declaration order (also the
+#: sections of config/planner.yaml and of --help).
+SECTIONS = (('node (ros/planner_node.py)', NodeOptions),
+            ('supervision (core/loop.py)', Supervision),
+            ('planner core (core/config.py)', PlannerConfig))
+GROUPS = tuple(cls for _, cls in SECTIONS)
 
 
 class PlannerNode(Node):
@@ -118,9 +144,11 @@ class PlannerNode(Node):
     def __init__(self, **kwargs) -> None:
         super().__init__(NODE_NAME, **kwargs)
         declare(self, *GROUPS)
+        warn_undeclared(self)   # a misspelt name: said, with the closest one
         # a bad start value raises ConfigError naming it (exit code 2)
         self.options = read(self, NodeOptions)
-        self.ctl = DecisionLoop(read(self, PlannerConfig), read(self, Supervision))
+        self.ctl = DecisionLoop(self._within_robot(read(self, PlannerConfig)),
+                                read(self, Supervision))
         self.intake = self._intake()
         self._pending: dict[type, object] = {}   # groups validated by the on-set callback
         self.add_on_set_parameters_callback(self._validate_parameters)
@@ -169,15 +197,37 @@ class PlannerNode(Node):
             f'cmd_vel={"TwistStamped" if stamped else "Twist"}')
 
     # --- parameters -------------------------------------------------------------------
+    def _within_robot(self, cfg: PlannerConfig) -> PlannerConfig:
+        """At start: each limit beyond what the robot can do (``robot``) clamped to the
+        robot's, with a warning naming both numbers, and the parameter set to it."""
+        robot = self.options.robot_description
+        if robot is None:
+            return cfg
+        beyond = beyond_robot(cfg, robot)
+        cfg, notes = clamp_to_robot(cfg, robot)
+        for note in notes:
+            self.get_logger().warn(f'{note} (robot: {self.options.robot}; a robot of your '
+                                   f'own: robot:={OTHER_ROBOT})')
+        # (before the callbacks are added: nothing else to validate or apply)
+        self.set_parameters([Parameter(name, value=limit) for name, _, limit in beyond])
+        return cfg
+
     def _validate_parameters(self, params: list) -> SetParametersResult:
-        """Refuse a change that makes any parameter group invalid (old values kept); the
-        groups built here are what the post-set callback applies."""
+        """Refuse a change that makes any parameter group invalid, or a limit beyond what
+        the robot can do (old values kept); the groups built here are what the post-set
+        callback applies."""
         changes = {p.name: p.value for p in params}
         try:
             self._pending = {group: read(self, group, changes) for group in GROUPS}
         except ConfigError as exc:
             self._pending = {}
             return SetParametersResult(successful=False, reason=str(exc))
+        robot = self._pending[NodeOptions].robot_description
+        beyond = beyond_robot(self._pending[PlannerConfig], robot) if robot else []
+        if beyond:
+            self._pending = {}
+            return SetParametersResult(successful=False, reason='; '.join(
+                beyond_robot_text(*b, robot) for b in beyond))
         return SetParametersResult(successful=True)
 
     def _apply_parameters(self, params: list) -> None:
@@ -258,15 +308,21 @@ class PlannerNode(Node):
         if refused:
             self.get_logger().error(refused)
         elif new:
-            self._log_goal()
+            self._took_goal()
 
     def _set_goal(self, goal: np.ndarray) -> None:
         if self.ctl.set_goal(goal):
-            self._log_goal()
+            self._took_goal()
 
-    def _log_goal(self) -> None:
+    def _took_goal(self) -> None:
+        """Log a new goal and say on ~/status at once that it was taken (``driving: new
+        goal``), so that a final state that follows is this goal's, even one the first
+        tick decides (a goal already within the tolerance)."""
         goal = self.ctl.goal
         self.get_logger().info(f'goal ({goal[0]:.2f}, {goal[1]:.2f})')
+        self._last_state = self.ctl.text
+        if listened(self.status_pub):
+            self.status_pub.publish(String(data=self.ctl.text))
 
     # --- the planning cycle -----------------------------------------------------------
     def _take_arrived_inputs(self, tick_ns: int) -> list:
@@ -389,9 +445,29 @@ def _due(last: float | None, now: float, period: float, tick: float) -> bool:
     return last is None or now < last or now - last >= period - 0.5 * tick
 
 
+def usage() -> str:
+    """``subapf-planner --help``."""
+    return node_usage(
+        'subapf-planner', 'planner_node', NODE_NAME, """
+        The subapf_planner local planner node: scan (sensor_msgs/LaserScan), odom
+        (nav_msgs/Odometry) and a goal on goal_pose (geometry_msgs/PoseStamped in odom or
+        map_frame, e.g. RViz's 2D Goal Pose) in; cmd_vel (TwistStamped, or Twist with
+        enable_stamped_cmd_vel:=false) out at planning_frequency; ~/status (std_msgs/String
+        "state: reason"; states idle, waiting, mapping, driving, stopped and the final
+        reached, stuck, unreachable), ~/markers, ~/map, ~/plan, ~/correction.
+
+        Example: subapf-planner --ros-args --params-file config/planner.yaml
+        --params-file config/robots/waffle_pi.yaml -p use_sim_time:=true""",
+        SECTIONS, 'A robot file, config/robots/<robot>.yaml (burger, waffle_pi, '
+        "turtlebot4), loaded after it, sets that robot's own: robot, footprint and "
+        'clearances, laser frame and mounting, limits, cmd_vel type '
+        '(launch/planner.launch.py robot:=... loads both).')
+
+
 def main(args: list[str] | None = None) -> int:
     return spin_node(PlannerNode, 'subapf-planner: bad parameter',
-                     (ConfigError, ParameterException), PlannerNode.stop_robot, args)
+                     (ConfigError, ParameterException), PlannerNode.stop_robot, args,
+                     usage=usage)
 
 
 if __name__ == '__main__':

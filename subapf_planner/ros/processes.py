@@ -5,6 +5,7 @@ from __future__ import annotations
 import ctypes
 import os
 from pathlib import Path
+import random
 import signal
 import subprocess
 import sys
@@ -33,6 +34,42 @@ def use_package_profile() -> str | None:
         return None
     os.environ['FASTRTPS_DEFAULT_PROFILES_FILE'] = path
     return path
+
+
+#: Domains a private run picks from (tests lease theirs above: test/conftest.py).
+PRIVATE_DOMAINS = range(1, 101)
+
+
+def domains_in_use() -> set[int]:
+    """The ROS_DOMAIN_ID of every other process on this machine that has one in its
+    environment (Linux /proc; elsewhere, and for processes not readable, none)."""
+    found = set()
+    proc = Path('/proc')
+    if not proc.is_dir():
+        return found
+    for entry in proc.iterdir():
+        if not entry.name.isdigit() or int(entry.name) == os.getpid():
+            continue
+        try:
+            env = (entry / 'environ').read_bytes().split(b'\0')
+        except OSError:
+            continue
+        for var in env:
+            if var.startswith(b'ROS_DOMAIN_ID='):
+                try:
+                    found.add(int(var.split(b'=', 1)[1]))
+                except ValueError:
+                    pass
+    return found
+
+
+def free_domain(rng: random.Random | None = None) -> int:
+    """A domain of PRIVATE_DOMAINS that no process on this machine has in its
+    environment (at random among them; any of them when all are taken)."""
+    rng = rng or random.Random()
+    busy = domains_in_use()
+    free = [d for d in PRIVATE_DOMAINS if d not in busy]
+    return rng.choice(free or list(PRIVATE_DOMAINS))
 
 
 def join_domain(domain_id: int) -> dict[str, str]:
@@ -95,9 +132,11 @@ def rss_mib(pid: int) -> float:
 
 
 def stop(children: list[subprocess.Popen]) -> None:
-    """SIGINT, then SIGTERM, then SIGKILL, to each child's process group."""
-    for sig, wait in ((signal.SIGINT, CHILD_STOP_TIMEOUT), (signal.SIGTERM, 2.0),
-                      (signal.SIGKILL, 2.0)):
+    """SIGTERM, then SIGKILL, to each child's process group. A node that runs stops
+    cleanly on SIGTERM as on SIGINT (ros/spinning.py: zero velocity first); one still
+    starting (importing, before its handlers) ends at once and silently, where SIGINT
+    would print a KeyboardInterrupt traceback from inside some import."""
+    for sig, wait in ((signal.SIGTERM, CHILD_STOP_TIMEOUT), (signal.SIGKILL, 2.0)):
         alive = [c for c in children if c.poll() is None]
         if not alive:
             return

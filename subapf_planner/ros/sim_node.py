@@ -3,10 +3,14 @@
 Publishes ``/clock`` (rosgraph_msgs/Clock) and stamps everything with
 simulated time, ``scan`` (frame base_scan, sensor-data QoS, 5 Hz), ``odom``
 (odom -> base_footprint, 20 Hz), ``ground_truth`` (nav_msgs/Odometry in the
-world frame) and the run's outcome on ``sim_outcome`` (std_msgs/String:
-reached, collision or timeout; transient-local, published once). Subscribes
-``cmd_vel`` (TwistStamped, or Twist with enable_stamped_cmd_vel:=false).
-Physics advances in steps of 50 ms of simulated time on a wall-clock timer,
+world frame) and each attempt's outcome on ``sim_outcome`` (std_msgs/String:
+reached, collision or timeout; transient-local, once per attempt). Subscribes
+``cmd_vel`` (TwistStamped, or Twist with enable_stamped_cmd_vel:=false) and
+``goal_pose`` (geometry_msgs/PoseStamped in odom or map: the world frame at the
+start), as the planner does. The first attempt is at the world's goal from the
+start; each new goal starts another, with its own time limit (sim/attempt.py).
+The simulation never stops at an outcome: /clock goes on, and the next goal is
+served. Physics advances in steps of 50 ms of simulated time on a wall-clock timer,
 ``rate`` times faster than real time. ``/tf`` and ``/tf_static`` go out when
 tf2_msgs is installed (not among the PyPI ROS wheels; odom carries the same pose).
 A world with moving obstacles also gets ``moving_obstacles``
@@ -15,12 +19,12 @@ A world with moving obstacles also gets ``moving_obstacles``
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
-import math
+from dataclasses import dataclass
 import sys
 
-from geometry_msgs.msg import Twist, TwistStamped
+from geometry_msgs.msg import PoseStamped, Twist, TwistStamped
 from nav_msgs.msg import Odometry
+import numpy as np
 from rclpy.node import Node
 from rclpy.qos import qos_profile_sensor_data
 from rosgraph_msgs.msg import Clock
@@ -29,9 +33,8 @@ from std_msgs.msg import String
 from visualization_msgs.msg import MarkerArray
 
 from ..core.params import ConfigError, check_fields, param
-from ..core.status import Outcome
-from ..sim.faults import FAULT_SEED_OFFSET, ScanDelivery, ScanFaults
-from ..sim.outcome import outcome_of
+from ..sim.attempt import Attempts
+from ..sim.faults import FAULT_SEED_OFFSET, ScanDelivery, ScanFaults, delivery_faults
 from ..sim.simulator import ROBOT, BurgerSim, SimConfig
 from ..sim.world import WorldError, load_world
 from .conversions import (
@@ -42,16 +45,17 @@ from .conversions import (
     transform_msg,
 )
 from .markers import moving_obstacle_markers
-from .parameters import declare, read
+from .parameters import declare, read, warn_undeclared
 from .qos import LATCHED, listened
 from .spinning import spin_node
+from .usage import node_usage
 
 #: Simulated time per timer tick [s]; odometry and /clock go out every tick.
 TICK = 0.05
 SCAN_PERIOD = 0.2
-#: After ``reached`` the simulation goes on while the robot is commanded to move (the
-#: planner drives on inside the tolerance to arrival_distance), at most this long [s].
-ARRIVAL_TIME = 10.0
+#: Frames a goal on goal_pose may be given in: the simulator's odom frame, and map (the
+#: planner's memory frame: odom as it was at the start); both are the world frame.
+GOAL_FRAMES = ('', 'odom', 'map')
 #: REP-105 frames of the burger: base_link above base_footprint, base_scan in base_link.
 BASE_LINK_HEIGHT = ROBOT.base_link_height
 LASER_IN_BASE_LINK = (ROBOT.laser.x, ROBOT.laser.y, ROBOT.laser.z - BASE_LINK_HEIGHT)
@@ -73,22 +77,28 @@ class SimNodeOptions:
         check_fields(self)
 
 
-#: The parameter groups of the node, in declaration order.
-GROUPS = (SimNodeOptions, SimConfig, ScanFaults)
+#: The parameter groups of the node with their titles, in declaration order (also the
+#: sections of config/planner.yaml and of --help).
+SECTIONS = (('node (ros/sim_node.py)', SimNodeOptions),
+            ('simulator (sim/simulator.py)', SimConfig),
+            ('scan faults (sim/faults.py)', ScanFaults))
+GROUPS = tuple(cls for _, cls in SECTIONS)
 
 
 class SimNode(Node):
     def __init__(self, **kwargs) -> None:
         super().__init__('subapf_sim', **kwargs)
         declare(self, *GROUPS)
+        warn_undeclared(self)
         options = read(self, SimNodeOptions)
         if not options.world:
-            raise WorldError('parameter "world" (a world file) is required')
+            raise WorldError('parameter "world" (a world file) is required: --ros-args -p '
+                             'world:=FILE (see --help)')
         self.world = load_world(options.world)
         sim_cfg = read(self, SimConfig)
         self.sim = BurgerSim(self.world, sim_cfg)
-        self._scans: ScanDelivery[LaserScan] = ScanDelivery(read(self, ScanFaults),
-                                                            sim_cfg.seed + FAULT_SEED_OFFSET)
+        self._scans: ScanDelivery[LaserScan] = ScanDelivery(
+            delivery_faults(sim_cfg, read(self, ScanFaults)), sim_cfg.seed + FAULT_SEED_OFFSET)
         self.clock_pub = self.create_publisher(Clock, '/clock', 10)
         self.scan_pub = self.create_publisher(LaserScan, 'scan', qos_profile_sensor_data)
         self.odom_pub = self.create_publisher(Odometry, 'odom', 10)
@@ -99,8 +109,8 @@ class SimNode(Node):
         self._setup_tf()
         cmd_type = TwistStamped if options.enable_stamped_cmd_vel else Twist
         self.create_subscription(cmd_type, 'cmd_vel', self._on_cmd, 10)
-        self.outcome: Outcome | None = None
-        self._outcome_time = math.inf
+        self.create_subscription(PoseStamped, 'goal_pose', self._on_goal, 10)
+        self.attempts = Attempts(self.world)
         self._next_scan = 0.0
         # Fast mode: several ticks per timer callback, so the executor's overhead per
         # callback does not cap the speed-up.
@@ -130,14 +140,27 @@ class SimNode(Node):
     def _on_cmd(self, msg: Twist | TwistStamped) -> None:
         self.sim.set_command(*cmd_from_msg(msg))
 
+    def _on_goal(self, msg: PoseStamped) -> None:
+        """A goal (the planner's too): a new attempt, unless it is the running one's."""
+        goal = np.array([msg.pose.position.x, msg.pose.position.y], dtype=float)
+        if msg.header.frame_id not in GOAL_FRAMES or not np.all(np.isfinite(goal)):
+            self.get_logger().info(f'goal in frame "{msg.header.frame_id}" at {goal}: not '
+                                   'an attempt (the planner refuses it too)')
+            return
+        if self.attempts.goal(goal, self.sim.time):
+            a = self.attempts.current
+            self.get_logger().info(
+                f'attempt {a.number}: goal ({goal[0]:.2f}, {goal[1]:.2f}) at '
+                f't={a.start:.1f} s, time limit {self.world.time_limit:g} s')
+
     def _on_timer(self) -> None:
         for _ in range(self.ticks_per_call):
             self._on_tick()
 
     def _on_tick(self) -> None:
         sim = self.sim
-        if self._running():
-            sim.step(TICK)
+        sim.collided = False   # re-armed each tick: whether it touched during this one
+        sim.step(TICK)
         t = sim.time
         pose, twist = sim.odometry()
         self.odom_pub.publish(odom_to_msg(pose, twist, t))
@@ -146,29 +169,21 @@ class SimNode(Node):
                 'odom', 'base_footprint', (pose[0], pose[1], 0.0), pose[2], t)]))
         if listened(self.truth_pub):
             self.truth_pub.publish(odom_to_msg(sim.true_pose(), twist, t, 'world'))
+        for sweep in sim.sweeps():   # as the lidar's driver publishes them
+            self._scans.capture(scan_to_msg(sweep, 'base_scan'), sim.sweep_end(sweep))
         if t + 1e-9 >= self._next_scan:
             self._next_scan += SCAN_PERIOD
-            self._scans.capture(scan_to_msg(replace(sim.scan(), stamp=t), 'base_scan'), t)
             if self.moving_pub is not None and listened(self.moving_pub):
                 # where they truly are, at the scan rate
                 self.moving_pub.publish(moving_obstacle_markers(
                     self.world.moving_at(t), 'odom', seconds_to_stamp(t)))
-        # scans go out scan_latency after capture, stamped with their capture time
+        # scans go out after the lidar's latency and the faults', stamped with their
+        # first beam's instant
         for msg in self._scans.due(t):
             self.scan_pub.publish(msg)
         # the clock last: a node on sim time then has this tick's data when its timers fire
         self.clock_pub.publish(Clock(clock=seconds_to_stamp(t)))
-        if self.outcome is None:
-            self._check_outcome()
-
-    def _running(self) -> bool:
-        """Whether the simulation steps: until the outcome, and after ``reached`` while
-        the robot is still commanded to move (the simulator's own command: zero once
-        it is older than cmd_timeout), ARRIVAL_TIME at most."""
-        if self.outcome is None:
-            return True
-        return self.outcome is Outcome.REACHED and self.sim.wheel_command() != (0.0, 0.0) \
-            and self.sim.time < self._outcome_time + ARRIVAL_TIME
+        self._check_outcome()
 
     def close(self) -> None:
         """Release the physics server."""
@@ -176,16 +191,40 @@ class SimNode(Node):
 
     def _check_outcome(self) -> None:
         sim = self.sim
-        self.outcome = outcome_of(self.world, sim.true_pose(), sim.collided, sim.time)
-        if self.outcome is not None:
-            self._outcome_time = sim.time
-            self.outcome_pub.publish(String(data=str(self.outcome)))
+        outcome = self.attempts.update(sim.true_pose(), sim.collided, sim.time)
+        if outcome is not None:
+            a = self.attempts.current
+            self.outcome_pub.publish(String(data=str(outcome)))
             stood = ' (hit while stopped)' if sim.collided and sim.hit_while_stopped else ''
-            self.get_logger().info(f'outcome: {self.outcome}{stood} at t={sim.time:.1f} s')
+            self.get_logger().info(
+                f'outcome: {outcome}{stood} at t={sim.time:.1f} s (attempt {a.number}, '
+                f'{sim.time - a.start:.1f} s after its goal); simulating on, the next goal '
+                'on goal_pose starts the next attempt')
+
+
+def usage() -> str:
+    """``subapf-sim --help``."""
+    return node_usage(
+        'subapf-sim', 'sim_node', 'subapf_sim', """
+        The PyBullet TurtleBot3 burger stand-in: loads the world file (parameter world,
+        required; format v1, docs/worlds.md), subscribes cmd_vel and goal_pose, publishes
+        /clock, scan (base_scan, 5 Hz), odom (20 Hz), ground_truth, moving_obstacles, /tf
+        and /tf_static (with tf2_msgs), and on sim_outcome (std_msgs/String, transient
+        local) the outcome of each attempt: reached, collision or timeout.
+
+        The first attempt is at the world's goal from the start; each goal sent on
+        goal_pose (frame odom or map: the world frame) starts another, with the world's
+        time limit of its own. After an outcome the simulation goes on (/clock keeps
+        advancing) and serves the next goal.
+
+        Example: subapf-sim --ros-args -p world:=sim/worlds/fig6d_big_wall.yaml
+        -p rate:=5.0""",
+        SECTIONS)
 
 
 def main(args: list[str] | None = None) -> int:
-    return spin_node(SimNode, 'subapf-sim', (WorldError, ConfigError), SimNode.close, args)
+    return spin_node(SimNode, 'subapf-sim', (WorldError, ConfigError), SimNode.close, args,
+                     usage=usage)
 
 
 if __name__ == '__main__':

@@ -16,6 +16,7 @@ from rclpy.duration import Duration
 from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
 from rclpy.node import Node
 from rclpy.signals import SignalHandlerOptions
+from rclpy.utilities import remove_ros_args
 
 from .processes import use_package_profile
 
@@ -115,10 +116,35 @@ def wait_for_acks(node: Node, timeout: float = SHUTDOWN_ACK_TIMEOUT) -> bool:
     return acked
 
 
+def command_line(args: list[str] | None, usage: Callable[[], str] | None,
+                 prog: str) -> int | None:
+    """The arguments before (and around) ``--ros-args``, looked at before rclpy starts:
+    ``-h`` or ``--help`` prints ``usage()`` and gives 0; any other gives 2 with a one-line
+    error (a ROS argument belongs after ``--ros-args``); None: nothing of the sort, go
+    on. ``args`` as rclpy.init takes them (None: sys.argv, the program first)."""
+    if usage is None:
+        return None
+    argv = list(sys.argv if args is None else args)
+    try:
+        extra = remove_ros_args(argv)[1:]
+    except Exception:   # noqa: BLE001 (a malformed --ros-args: rclpy.init says what)
+        return None
+    if '-h' in extra or '--help' in extra:
+        sys.stdout.write(usage())
+        return 0
+    if extra:
+        print(f'{prog}: error: unrecognized arguments: {" ".join(extra)} (ROS arguments '
+              'go after --ros-args, e.g. --ros-args -p NAME:=VALUE; see --help)',
+              file=sys.stderr)
+        return 2
+    return None
+
+
 def spin_node(make_node: Callable[[], Node], prog: str,
               bad_input: tuple[type[BaseException], ...],
               on_shutdown: Callable[[Node], None] | None = None,
-              args: list[str] | None = None) -> int:
+              args: list[str] | None = None,
+              usage: Callable[[], str] | None = None) -> int:
     """init, build, spin; on SIGINT, SIGTERM or external shutdown: ``on_shutdown``
     (e.g. publish zero velocity), destroy_node, try_shutdown, and return 0.
 
@@ -133,6 +159,10 @@ def spin_node(make_node: Callable[[], Node], prog: str,
     The process uses the package's Fast DDS profile unless the user set another
     (processes.use_package_profile).
 
+    With ``usage``, the command line is looked at first (command_line): ``--help``
+    prints it and returns 0, an argument that is not a ROS one returns 2; in both
+    cases before rclpy is initialised, so nothing is started.
+
     Errors: a ``bad_input`` exception raised while *building* the node (bad
     parameter, bad world file) prints its message, no traceback, and returns 2. Any
     other exception, and any exception at all while spinning (a bug, even if it is
@@ -140,6 +170,9 @@ def spin_node(make_node: Callable[[], Node], prog: str,
     console script) after the same shutdown sequence (``on_shutdown`` first, so
     the robot is stopped).
     """
+    done = command_line(args, usage, prog.split(':')[0])
+    if done is not None:
+        return done
     use_package_profile()
     rclpy.init(args=args, signal_handler_options=SignalHandlerOptions.NO)
     stop = stop_on_signals()

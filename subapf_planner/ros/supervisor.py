@@ -65,6 +65,8 @@ class Supervisor:
         self._written = 0   # messages recorded (close drains until none come)
         self.path: list = []
         self.sim_time = 0.0
+        #: Simulated time when the outcome came (the last ground truth then) [s].
+        self.outcome_time: float | None = None
         self.outcome: str | None = None
         self.status = ''
         self.rss_mib: dict[str, list[float]] = {}
@@ -88,7 +90,8 @@ class Supervisor:
         return write
 
     def _on_outcome(self, msg: String) -> None:
-        self.outcome = msg.data
+        if self.outcome is None:   # the simulator goes on after it: the first is the run's
+            self.outcome, self.outcome_time = msg.data, self.sim_time
 
     def _on_truth(self, msg: Odometry) -> None:
         self.path.append(pose_from_odom(msg))
@@ -129,9 +132,14 @@ class Supervisor:
                     continue
             if self.outcome is not None:
                 return self.outcome
-            dead = [c for c in children if c.poll() is not None]
+            dead = [(name, c) for name, c in zip(names or ('a node',) * len(children),
+                                                  children, strict=True)
+                     if c.poll() is not None]
             if dead:
-                return f'failed: a node exited with code {dead[0].returncode}'
+                name, child = dead[0]
+                if child.returncode == 2:   # spin_node: bad parameters, world or port
+                    return f'failed: {name} did not start (exit code 2)'
+                return f'failed: {name} exited with code {child.returncode}'
             # (re)send the goal until the planner has taken it
             waiting = not self.status or self.status.startswith(('idle', 'waiting'))
             if self.goal_pub.get_subscription_count() > 0 and waiting and (

@@ -21,7 +21,7 @@ from ..core.config import PlannerConfig
 from ..core.loop import DecisionLoop, Supervision
 from ..core.scan import Scan
 from ..core.status import Outcome, State
-from .faults import FAULT_SEED_OFFSET, ScanDelivery, ScanFaults
+from .faults import FAULT_SEED_OFFSET, ScanDelivery, ScanFaults, delivery_faults
 from .metrics import mean_abs_curvature, min_clearance, path_length
 from .outcome import outcome_of
 from .simulator import BurgerSim, SimConfig
@@ -55,6 +55,15 @@ class EpisodeResult:
     #: Per tick, how long the work after its command took [ms]
     #: (DecisionLoop.after_tick: the scan matched to and written into the memory).
     after_ms: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    #: Per planning cycle, the distance from the pose the planner planned from (odometry
+    #: corrected by the scan alignment) to the true pose [m] (the memory's frame is the
+    #: world's: the simulator's odom starts at the world's start pose).
+    pose_error: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    #: Whether anything in the world moves (evading in a world where nothing does is a
+    #: ghost's doing).
+    moving_world: bool = False
+    #: Per planning cycle (with pose_error), odometry's own distance to the true pose [m].
+    odom_error: np.ndarray = field(default_factory=lambda: np.zeros(0))
 
     @property
     def cycles(self) -> int:
@@ -78,6 +87,14 @@ class EpisodeResult:
             'goal_tolerance': world.goal_tolerance,
             'statuses': dict(self.statuses),
             'hit_while_stopped': self.hit_while_stopped,
+            'pose_error_final': round(float(self.pose_error[-1]), 4)
+            if self.pose_error.size else None,
+            'pose_error_max': round(float(self.pose_error.max()), 4)
+            if self.pose_error.size else None,
+            'odom_error_final': round(float(self.odom_error[-1]), 4)
+            if self.odom_error.size else None,
+            'evading_cycles': int(self.statuses.get('evading', 0)),
+            'moving_world': self.moving_world,
         }
 
 
@@ -91,12 +108,14 @@ def run_episode(world: World, cfg: PlannerConfig, sim_cfg: SimConfig | None = No
     ``unreachable_timeout``), collides or runs out of time. ``label`` names the method
     in the result (default ``cfg.method``)."""
     sim_cfg = sim_cfg or SimConfig()
-    delivery: ScanDelivery[Scan] = ScanDelivery(faults or ScanFaults(),
+    delivery: ScanDelivery[Scan] = ScanDelivery(delivery_faults(sim_cfg, faults),
                                                 sim_cfg.seed + FAULT_SEED_OFFSET)
     cfg = cfg.replace(goal_tolerance=min(cfg.goal_tolerance, world.goal_tolerance))
     ctl = DecisionLoop(cfg, limits)
     ctl.set_goal(np.asarray(world.goal, float), in_map=True)   # a place in the world
     path, times, plan_ms, recomputed, statuses, field_ms, after_ms = [], [], [], [], {}, [], []
+    pose_error = []   # per planning cycle: the planned-from pose's distance to the truth
+    odom_error = []   # ... and odometry's own
     with BurgerSim(world, sim_cfg) as sim:
         while True:
             truth = sim.true_pose()
@@ -111,7 +130,8 @@ def run_episode(world: World, cfg: PlannerConfig, sim_cfg: SimConfig | None = No
             now = sim.time
             odom, _ = sim.odometry()
             ctl.update_odom(now, odom, now)
-            delivery.capture(sim.scan(), now)
+            for sweep in sim.sweeps():
+                delivery.capture(sweep, sim.sweep_end(sweep))
             for scan in delivery.due(now):
                 ctl.update_scan(scan, now)
             ctl.settle()   # as a node's idle time between ticks would (not timed)
@@ -120,6 +140,10 @@ def run_episode(world: World, cfg: PlannerConfig, sim_cfg: SimConfig | None = No
             if decision.result is not None:
                 plan_ms.append((time.perf_counter() - t0) * 1e3)
                 recomputed.append(decision.result.new_field)
+                if decision.result.pose is not None:
+                    pose_error.append(float(np.hypot(*(decision.result.pose[:2]
+                                                       - truth[:2]))))
+                    odom_error.append(float(np.hypot(*(odom[:2] - truth[:2]))))
                 if decision.result.new_field:
                     field_ms.append(ctl.field_seconds * 1e3)
             key = str(decision.result.command.status) if decision.result is not None \
@@ -137,4 +161,5 @@ def run_episode(world: World, cfg: PlannerConfig, sim_cfg: SimConfig | None = No
     return EpisodeResult(world.name, label or cfg.method, outcome, elapsed, np.asarray(path),
                          np.asarray(plan_ms), final, statuses, np.asarray(recomputed, bool),
                          np.asarray(times), hit_while_stopped, np.asarray(field_ms),
-                         np.asarray(after_ms))
+                         np.asarray(after_ms), np.asarray(pose_error), bool(world.moving),
+                         np.asarray(odom_error))

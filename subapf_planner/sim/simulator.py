@@ -2,9 +2,13 @@
 
 The robot is a real multibody (urdf/burger_standin.urdf) whose two wheels are
 velocity-controlled from (v, w): slip and acceleration are what PyBullet's
-contact model gives. The lidar is an LDS-01-like 2-D scanner made with
-``rayTestBatch``: 360 beams from angle 0, 0.12 to 3.5 m, no-return beams as
-+inf, optional Gaussian range noise and dropped beams (also +inf). Odometry
+contact model gives. The lidar is a 2-D scanner made with ``rayTestBatch``
+(360 beams from angle 0, 0.12 to 3.5 m, no-return beams as +inf) and, by
+default, as imperfect as the datasheet of the robot's lidar says (sim/sensor.py):
+range noise growing with range, beams dropped at random and in runs, mixed
+pixels at depth edges, and each beam cast at its own instant of the sweep from
+where the laser is then (``sweeps``: the timed sweeps, as a driver publishes
+them); ``sensor: ideal`` casts exact rays at one instant. Odometry
 is the base's motion, optionally with the systematic error of wheel odometry
 (distance and turn-rate scales) and noise; the ground truth is kept apart for
 scoring. The simulator's odom frame is the world frame at the start.
@@ -35,6 +39,7 @@ from pybullet_utils.bullet_client import BulletClient
 from ..core.params import ConfigError, check_fields, param
 from ..core.robot import BURGER, compose
 from ..core.scan import Scan
+from .sensor import LIDARS, Lidar, corrupt
 from .world import Box, Circle, World
 
 OBSTACLE_HEIGHT = 0.5
@@ -73,10 +78,17 @@ class SimConfig:
                             read_only=True)
     range_min: float = param(0.12, 'Lidar minimum range', 'm', 0.0, 1.0, read_only=True)
     range_max: float = param(3.5, 'Lidar maximum range', 'm', 0.1, 100.0, read_only=True)
-    range_noise: float = param(0.01, 'Lidar range noise sigma (Gazebo TurtleBot3: 0.01)', 'm',
-                               0.0, 1.0, read_only=True)
-    beam_dropout: float = param(0.0, 'Fraction of beams dropped (reported +inf)', '',
-                                0.0, 1.0, read_only=True)
+    sensor: str = param('ideal', 'Lidar model: ideal (exact rays at one instant, plus '
+                        'range_noise and beam_dropout) or realistic (the datasheet errors '
+                        'of `lidar`, each beam at its own instant of the sweep, latency and '
+                        'lost scans: sim/sensor.py)', choices=('ideal', 'realistic'),
+                        read_only=True)
+    lidar: str = param('lds01', "Whose datasheet the realistic sensor follows (the burger's "
+                       'LDS-01; sim/sensor.py LIDARS)', choices=tuple(LIDARS), read_only=True)
+    range_noise: float = param(0.0, 'Extra lidar range noise sigma on top of the sensor '
+                               "model (the bench's faults)", 'm', 0.0, 1.0, read_only=True)
+    beam_dropout: float = param(0.0, 'Extra fraction of beams dropped (reported +inf) on top '
+                                'of the sensor model', '', 0.0, 1.0, read_only=True)
     odom_noise: float = param(0.0, 'Relative odometry drift per step', '', 0.0, 1.0,
                               read_only=True)
     odom_distance_scale: float = param(1.0, 'Odometry reports the distance driven times '
@@ -103,6 +115,15 @@ class SimConfig:
             raise ConfigError(f'range_min: {self.range_min} must be below range_max '
                               f'{self.range_max}')
 
+    @property
+    def model(self) -> Lidar:
+        """The lidar whose errors and timing the realistic sensor has."""
+        return LIDARS[self.lidar]
+
+    @property
+    def realistic(self) -> bool:
+        return self.sensor == 'realistic'
+
 
 class BurgerSim:
     """One world, one robot, fixed-step physics. Not thread-safe."""
@@ -128,6 +149,13 @@ class BurgerSim:
         self._truth_prev = self.true_pose()
         n = self.config.scan_beams
         self._angles = 2.0 * math.pi * np.arange(n) / n
+        #: The sweep being taken: its start [s], beams cast so far, their true ranges;
+        #: and the sweeps completed since the last ``sweeps()``.
+        self._sweep_t0 = 0.0
+        self._sweep_cast = 0
+        self._sweep_true = np.full(n, np.inf)
+        self._swept: list[Scan] = []
+        self._advance_sweep()
 
     def _build(self) -> None:
         c = self._client
@@ -230,6 +258,7 @@ class BurgerSim:
                 self._place_movers(placed[:, i])
             pybullet.stepSimulation(physicsClientId=cid)
             self.time = t
+            self._advance_sweep()
             if not perfect:
                 self._integrate_odom()
             if not self.collided and self._touching_obstacle():
@@ -303,23 +332,72 @@ class BurgerSim:
         pose = self.true_pose() if self._odom is None else self._odom.copy()
         return pose, self.true_velocity()
 
-    def scan(self) -> Scan:
-        """One LDS-01-like sweep from base_scan at the current pose (+inf: no return)."""
+    def _cast(self, beams: slice) -> np.ndarray:
+        """True ranges [m] (+inf: no return) of ``beams`` of a sweep, cast now from where
+        the laser is."""
         cfg = self.config
         pose = self.true_pose()
         ox, oy, _ = compose(pose, ROBOT.laser.planar)
-        a = self._angles + pose[2]
+        a = self._angles[beams] + pose[2]
         n = a.size
         origin = np.tile([ox, oy, ROBOT.laser.z], (n, 1))
         ends = origin + cfg.range_max * np.column_stack((np.cos(a), np.sin(a), np.zeros(n)))
         hits = pybullet.rayTestBatch(origin.tolist(), ends.tolist(),
                                      numThreads=cfg.scan_threads, physicsClientId=self._cid)
-        frac = np.array([h[2] if h[0] >= 0 else np.inf for h in hits])
-        ranges = frac * cfg.range_max
+        return np.array([h[2] if h[0] >= 0 else np.inf for h in hits]) * cfg.range_max
+
+    def _reported(self, true: np.ndarray) -> np.ndarray:
+        """The ranges the lidar reports for the true ones: the sensor model's errors
+        (realistic), the extra noise and dropout, +inf outside [range_min, range_max)."""
+        cfg = self.config
+        ranges = corrupt(true, cfg.model, self._rng) if cfg.realistic else true.copy()
+        n = ranges.size
         if cfg.range_noise > 0.0:
             ranges = ranges + cfg.range_noise * self._rng.standard_normal(n)
         if cfg.beam_dropout > 0.0:
             ranges[self._rng.random(n) < cfg.beam_dropout] = np.inf
-        ranges[(ranges < cfg.range_min) | (ranges >= cfg.range_max)] = np.inf
-        return Scan(ranges, 0.0, 2.0 * math.pi / n, cfg.range_min, cfg.range_max,
-                    stamp=self.time)
+        ranges[(ranges < cfg.range_min) | (ranges >= cfg.range_max)] = \
+            cfg.model.no_return if cfg.realistic else np.inf
+        return ranges
+
+    def _advance_sweep(self) -> None:
+        """Cast the beams of the sweep in progress whose instants have come (all at its
+        start with the ideal sensor), and complete it when its last beam is cast."""
+        cfg = self.config
+        n, period = cfg.scan_beams, cfg.model.scan_time
+        inc = period / n if cfg.realistic else 0.0
+        tau = self.time - self._sweep_t0
+        if tau < -1e-9:
+            return
+        due = n if inc == 0.0 else min(n, int(math.floor(tau / inc + 1e-6)) + 1)
+        if due > self._sweep_cast:
+            self._sweep_true[self._sweep_cast:due] = self._cast(slice(self._sweep_cast, due))
+            self._sweep_cast = due
+        if due < n:
+            return
+        self._swept.append(Scan(self._reported(self._sweep_true), 0.0, 2.0 * math.pi / n,
+                                cfg.range_min, cfg.range_max, stamp=self._sweep_t0,
+                                time_increment=inc, scan_time=period))
+        self._sweep_t0 += period
+        self._sweep_cast = 0
+        self._sweep_true = np.full(n, np.inf)
+
+    def sweeps(self) -> list[Scan]:
+        """The sweeps completed since the last call, oldest first: each stamped with its
+        first beam's instant, beam i taken ``time_increment`` after the one before
+        (``scan_time`` a sweep), as a lidar driver publishes them."""
+        done, self._swept = self._swept, []
+        return done
+
+    @staticmethod
+    def sweep_end(scan: Scan) -> float:
+        """When a sweep's last beam was taken [s]."""
+        return scan.stamp + scan.time_increment * (np.size(scan.ranges) - 1)
+
+    def scan(self) -> Scan:
+        """One sweep from base_scan cast now, at the current pose, with the sensor's
+        range errors but no sweep timing (+inf: no return)."""
+        cfg = self.config
+        n = cfg.scan_beams
+        return Scan(self._reported(self._cast(slice(0, n))), 0.0, 2.0 * math.pi / n,
+                    cfg.range_min, cfg.range_max, stamp=self.time)

@@ -22,6 +22,7 @@ import dataclasses
 import datetime
 import importlib.metadata
 import json
+import math
 from pathlib import Path
 import re
 import shlex
@@ -49,6 +50,8 @@ DEFAULT_METHODS = ('subharmonic_sampling:geodesic', 'subharmonic_sampling:euclid
                    'subharmonic:euclidean', 'traditional:euclidean', 'harmonic:euclidean',
                    'dwa:euclidean', 'dwa:geodesic')
 FIELDS = ('geodesic', 'euclidean')
+#: --faults: the four faults the bench has long had, on top of the sensor model.
+FOUR_FAULTS = {'beam_dropout': 0.2, 'scan_dropout': 0.2, 'scan_latency': 0.1}
 #: How long --cluster waits for its scheduler [s].
 CLUSTER_CONNECT_TIMEOUT = 30.0
 
@@ -167,6 +170,35 @@ def by_family(runs: list[dict], methods: list[str]) -> str:
     return '\n'.join(lines) + '\n'
 
 
+def _percentile(values: list[float], q: float) -> float:
+    return float(np.percentile(values, q)) if values else math.nan
+
+
+def perception(runs: list[dict], methods: list[str]) -> str:
+    """Per method: the planned-from pose's error against the truth when the planner
+    stopped at the goal (median, p95, max) and at worst in a run (median, max); cycles
+    spent evading in worlds where nothing moves (all, share of their cycles, the most in
+    one run)."""
+    lines = ['| method | pose error at arrival [m] median / p95 / max | worst pose error '
+             'in a run [m] median / max | evading cycles in static worlds (share, most in '
+             'a run) |', '|---|---|---|---|']
+    for m in methods:
+        rs = [r for r in runs if r['method'] == m]
+        final = [r['pose_error_final'] for r in rs
+                 if r['outcome'] in ('reached', 'missed') and r.get('pose_error_final')
+                 is not None]
+        worst = [r['pose_error_max'] for r in rs if r.get('pose_error_max') is not None]
+        static = [r for r in rs if not r.get('moving_world', False)]
+        evading = [r.get('evading_cycles', 0) for r in static]
+        cycles = sum(r['cycles'] for r in static)
+        lines.append(
+            f'| {m} | {_percentile(final, 50):.3f} / {_percentile(final, 95):.3f} / '
+            f'{max(final, default=math.nan):.3f} | {_percentile(worst, 50):.3f} / '
+            f'{max(worst, default=math.nan):.3f} | {sum(evading)} '
+            f'({sum(evading) / max(cycles, 1):.2%}, {max(evading, default=0)}) |')
+    return '\n'.join(lines) + '\n'
+
+
 def summarise(runs: list[dict], methods: list[str]) -> str:
     """Markdown table per method, then an outcome matrix method x world."""
     lines = ['| method | runs | reached | collisions | timeouts | abandoned | unreachable '
@@ -263,9 +295,15 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
                    "scheduler's address, e.g. tcp://scheduler:8786 (every worker needs "
                    'subapf_planner installed; --jobs is not used; plots are drawn here)')
     p.add_argument('--seed', type=int, default=0, help='simulator seed (noise)')
+    p.add_argument('--sensor', choices=('ideal', 'realistic'), default='ideal',
+                   help='the lidar: ideal (exact rays at one instant, delivered at once, with '
+                   "--noise; the default) or realistic (the LDS-01's datasheet errors, each "
+                   'beam at its own instant, latency and lost scans: sim/sensor.py)')
     p.add_argument('--noise', type=float, default=0.01,
-                   help='laser range noise sigma [m] (Gazebo TurtleBot3: 0.01)')
-    p.add_argument('--beam-dropout', type=float, default=0.0, help='fraction of dropped beams')
+                   help='laser range noise sigma on top of the sensor [m] (Gazebo '
+                   'TurtleBot3: 0.01)')
+    p.add_argument('--beam-dropout', type=float, default=0.0,
+                   help='extra fraction of dropped beams on top of the sensor')
     p.add_argument('--odom-scale', type=float, default=1.0,
                    help='odometry distance scale (1.02: reports 2 %% too far)')
     p.add_argument('--odom-yaw-scale', type=float, default=1.0,
@@ -273,7 +311,10 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
     p.add_argument('--scan-dropout', type=float, default=0.0,
                    help='probability that a scan never reaches the planner')
     p.add_argument('--scan-latency', type=float, default=0.0,
-                   help='seconds between a scan and its delivery to the planner')
+                   help="extra seconds between a scan and its delivery, on top of the sensor's")
+    p.add_argument('--faults', action='store_true',
+                   help='the four faults on top of the sensor: --noise 0.03 --beam-dropout 0.2 '
+                   '--scan-dropout 0.2 --scan-latency 0.1 (each still settable)')
     p.add_argument('--no-plots', action='store_true', help='skip the PNGs')
     p.add_argument('--animate', action='store_true',
                    help="also write an animated GIF of each world's runs")
@@ -290,7 +331,13 @@ def main(argv: list[str] | None = None) -> int:
         for m in methods:
             parse_method(m)
         cfg = load_config(args.params or default_params_file())
-        sim_cfg = SimConfig(seed=args.seed, range_noise=args.noise,
+        if args.faults:
+            for name, value in FOUR_FAULTS.items():
+                if getattr(args, name) == 0.0:
+                    setattr(args, name, value)
+            if args.noise == 0.01:
+                args.noise = 0.03
+        sim_cfg = SimConfig(seed=args.seed, sensor=args.sensor, range_noise=args.noise,
                             beam_dropout=args.beam_dropout,
                             odom_distance_scale=args.odom_scale,
                             odom_yaw_scale=args.odom_yaw_scale,
@@ -326,13 +373,15 @@ def main(argv: list[str] | None = None) -> int:
     runs = [r for world_runs in per_world for r, _ in world_runs]
     labels = list(dict.fromkeys(r['method'] for r in runs))
     doc = {'meta': provenance(argv),
-           'runs': runs, 'methods': labels, 'seed': args.seed, 'noise': args.noise,
+           'runs': runs, 'methods': labels, 'seed': args.seed, 'sensor': args.sensor,
+           'noise': args.noise,
            'beam_dropout': args.beam_dropout, 'scan_dropout': args.scan_dropout,
            'scan_latency': args.scan_latency, 'odom_distance_scale': args.odom_scale,
            'odom_yaw_scale': args.odom_yaw_scale, 'wall_time_s': round(wall, 2),
            'params': dataclasses.asdict(cfg)}
     (out / 'results.json').write_text(json.dumps(doc, indent=1))
     (out / 'summary.md').write_text(summarise(runs, labels) + '\n' + by_family(runs, labels)
+                                    + '\n' + perception(runs, labels)
                                     + '\n' + paired(runs, labels)
                                     + f'\n{len(runs)} runs in {wall:.1f} s wall time.\n')
     print((out / 'summary.md').read_text())

@@ -1,50 +1,222 @@
-"""``subapf-bringup``: simulator + planner as two processes, headless, on a private domain.
+"""``subapf-bringup``: simulator + planner as two processes, headless, on your ROS domain.
 
-Starts ``sim_node`` and ``planner_node`` with localhost-only discovery and a
-ROS_DOMAIN_ID of their own, sends the world's goal on ``goal_pose``, waits for
-the simulator's outcome, stops both (also on Ctrl-C or when a child dies),
-prints the outcome, simulated time and path length, writes a trajectory PNG,
-and exits 0 only when the goal was reached. ``--foxglove [PORT]`` also starts
-``foxglove_node``, which serves the run live to Foxglove on ws://127.0.0.1:PORT.
+Checks its arguments first (the world file, the planner's params file and its values,
+that the simulator can be the robot the params describe, the output paths, the
+domain): an error is one line, ``subapf-bringup: error: ...``, and exit code 2,
+before any process is started. Then starts ``sim_node`` and ``planner_node`` with
+localhost-only discovery in ROS_DOMAIN_ID (0, ROS's default, when unset;
+``--domain-id N``, or ``--private-domain`` for a free one of their own), sends the
+world's goal on ``goal_pose``, waits for the simulator's outcome, stops both (also on
+Ctrl-C or when a child dies: a node that fails to start is named, exit code 2),
+prints the outcome, simulated time and path length, writes a trajectory PNG, and
+exits 0 only when the goal was reached. One goal, one run: for more goals, start
+``sim_node`` and ``planner_node`` yourself (the simulator serves one goal after
+another). ``--foxglove [PORT]`` also starts ``foxglove_node``, which serves the run
+live to Foxglove on ws://127.0.0.1:PORT.
 """
 
 from __future__ import annotations
 
 import argparse
+from collections.abc import Iterator
+import contextlib
 from dataclasses import dataclass, field
+import os
 from pathlib import Path
-import random
 import subprocess
 import sys
+from typing import Mapping
 
 import numpy as np
 
-from ..core.config import METHODS, load_config
+from ..core.config import METHODS, ConfigError, load_params_file
+from ..core.params import build
 from ..ros.paths import default_params_file
-from ..ros.processes import join_domain, start, stop
+from ..ros.processes import free_domain, join_domain, start, stop
 from ..sim.metrics import path_length
 from ..sim.world import World, WorldError, load_world
 
+PROG = 'subapf-bringup'
+#: --domain-id takes these (the tests lease domains above them: test/conftest.py).
+DOMAIN_IDS = range(0, 102)
+#: ROS_DOMAIN_ID may be any domain Fast DDS's default port mapping allows.
+ENV_DOMAIN_IDS = range(0, 233)
+#: The robot the simulator is (sim/simulator.py: the burger), and its laser frame.
+SIM_ROBOT = 'burger'
+SIM_LASER_FRAME = 'base_scan'
+
+
+class BringupError(Exception):
+    """An argument the run cannot start with: one line, exit code 2."""
+
 
 def parse_args(argv: list[str] | None) -> argparse.Namespace:
-    p = argparse.ArgumentParser(prog='subapf-bringup', description=__doc__.splitlines()[0])
-    p.add_argument('--world', required=True, help='world file')
-    p.add_argument('--method', default=None, choices=METHODS, help='override the params file')
-    p.add_argument('--params', default=None, help='planner params YAML')
-    p.add_argument('--rate', type=float, default=1.0, help='simulation speed-up (1 = real time)')
+    p = argparse.ArgumentParser(
+        prog=PROG, description=' '.join(__doc__.split('\n\n')[1].replace('``', '').split()),
+        epilog="Defaults: the planner's parameters are the package's config/planner.yaml "
+        f'({_default_params()}) unless --params names another file (its '
+        '"subapf_planner:" section, checked before anything starts; a robot file of '
+        'config/robots/ alone works too, for the burger, the one robot the simulator can '
+        "be); the simulator's are the code's (subapf-sim --help), with --rate, --seed and "
+        '--noise. Example: subapf-bringup --world sim/worlds/fig6d_big_wall.yaml --rate 5')
+    p.add_argument('--world', required=True, help='world file (format v1, docs/worlds.md)')
+    p.add_argument('--method', default=None, choices=METHODS,
+                   help="override the params file's method")
+    p.add_argument('--params', default=None,
+                   help="planner params YAML (default: the package's config/planner.yaml)")
+    p.add_argument('--rate', type=float, default=1.0,
+                   help='simulation speed-up, in [0.1, 100] (default: 1, real time)')
     p.add_argument('--record', default=None, help='write an MCAP bag of the run')
     p.add_argument('--record-topics', nargs='+', default=None, metavar='TOPIC',
-                   help='topics to record (default: all of supervisor.RECORDED)')
+                   help='topics to record (default: all of supervisor.RECORDED but the map)')
     p.add_argument('--png', default=None, help='trajectory plot (default: WORLD_NAME.png)')
-    p.add_argument('--domain-id', type=int, default=None, help='ROS_DOMAIN_ID (default: random)')
-    p.add_argument('--seed', type=int, default=0, help='simulator seed')
-    p.add_argument('--noise', type=float, default=0.01, help='laser range noise [m]')
+    domain = p.add_mutually_exclusive_group()
+    domain.add_argument('--domain-id', type=int, default=None,
+                        help='ROS_DOMAIN_ID of the run, in [0, 101] (default: the '
+                             "environment's ROS_DOMAIN_ID, 0 when unset)")
+    domain.add_argument('--private-domain', action='store_true',
+                        help='run in a domain no process on this machine uses (from 1-100): '
+                             'RViz or Foxglove on your own domain will not see it')
+    p.add_argument('--seed', type=int, default=0, help='simulator seed (default: 0)')
+    p.add_argument('--noise', type=float, default=0.01,
+                   help='laser range noise [m] (default: 0.01)')
     p.add_argument('--foxglove', type=int, nargs='?', const=8765, default=None, metavar='PORT',
-                   help='serve the run live to Foxglove on ws://127.0.0.1:PORT (default '
-                        'port 8765; foxglove_node)')
+                   help='serve the run live to Foxglove on ws://127.0.0.1:PORT (port 8765 '
+                        'without a number; foxglove_node)')
     p.add_argument('--timeout', type=float, default=None,
                    help='wall-clock limit [s] (default: 2 x time_limit / rate + 30)')
     return p.parse_args(argv)
+
+
+def _default_params() -> str:
+    try:
+        return str(default_params_file())
+    except FileNotFoundError:
+        return 'not found in this install'
+
+
+def one_line(exc: BaseException) -> str:
+    """An exception's message on one line (a YAML error spans several)."""
+    return ' '.join(str(exc).split())
+
+
+def check_params(path: str) -> dict:
+    """The planner's values in the params file ``path``, checked as the planner would
+    check them, and that the simulator can be the robot they describe (BringupError,
+    one line, otherwise)."""
+    from ..ros.planner_node import GROUPS, OTHER_ROBOT
+    try:
+        values = load_params_file(path, 'subapf_planner')
+        for cls in GROUPS:
+            build(cls, values, ignore_unknown=True)
+    except ConfigError as exc:
+        text = one_line(exc)
+        raise BringupError(text if text.startswith(str(path)) else f'{path}: {text}') from exc
+    robot = values.get('robot', SIM_ROBOT)
+    if robot not in (SIM_ROBOT, OTHER_ROBOT):
+        raise BringupError(
+            f'{path} is for the {robot} (robot: {robot}), but the simulator can only be a '
+            f'TurtleBot3 burger (a simulated {robot} is not there yet); give a burger '
+            'params file (config/planner.yaml or config/robots/burger.yaml)')
+    laser = values.get('laser_frame', SIM_LASER_FRAME)
+    if laser not in (SIM_LASER_FRAME, ''):
+        raise BringupError(
+            f'{path}: laser_frame is {laser}, but the simulator (a TurtleBot3 burger) '
+            f'sends its scans in {SIM_LASER_FRAME}: the planner would drop every one; set '
+            f'laser_frame: {SIM_LASER_FRAME}')
+    return values
+
+
+def choose_domain(args: argparse.Namespace, environ: Mapping[str, str]) -> tuple[int, str]:
+    """The run's domain and where it comes from: --domain-id, --private-domain, else the
+    environment's ROS_DOMAIN_ID, else 0 (ROS's default)."""
+    if args.domain_id is not None:
+        if args.domain_id not in DOMAIN_IDS:
+            raise BringupError(f'--domain-id must be in [0, {DOMAIN_IDS[-1]}]')
+        return args.domain_id, '--domain-id'
+    if args.private_domain:
+        return free_domain(), 'private: --private-domain'
+    text = environ.get('ROS_DOMAIN_ID', '').strip()
+    if not text:
+        return 0, "ROS_DOMAIN_ID unset: ROS's default"
+    try:
+        domain = int(text)
+    except ValueError:
+        domain = -1
+    if domain not in ENV_DOMAIN_IDS:
+        raise BringupError(f'ROS_DOMAIN_ID={text!r} is not a domain id in [0, '
+                           f'{ENV_DOMAIN_IDS[-1]}]')
+    return domain, 'ROS_DOMAIN_ID'
+
+
+@contextlib.contextmanager
+def _stderr_silenced() -> Iterator[None]:
+    """File descriptor 2 to /dev/null while in the block (a C library's own output)."""
+    sys.stderr.flush()
+    saved = os.dup(2)
+    with open(os.devnull, 'w') as null:
+        os.dup2(null.fileno(), 2)
+    try:
+        yield
+    finally:
+        os.dup2(saved, 2)
+        os.close(saved)
+
+
+def _writable_folder(path: str, option: str) -> None:
+    folder = Path(path).resolve().parent
+    if not folder.is_dir() or not os.access(folder, os.W_OK):
+        raise BringupError(f'{option} {path}: cannot write in {folder}')
+
+
+@dataclass(frozen=True)
+class Plan:
+    """A run, every argument checked."""
+
+    world: World
+    world_path: str
+    params: str
+    method: str
+    domain: int
+    domain_source: str
+
+
+def prepare(args: argparse.Namespace, environ: Mapping[str, str]) -> Plan:
+    """Every check before a process starts (BringupError, one line, for the first
+    problem)."""
+    try:
+        world = load_world(args.world)
+    except WorldError as exc:
+        raise BringupError(one_line(exc)) from exc
+    if not 0.1 <= args.rate <= 100.0:
+        raise BringupError('--rate must be in [0.1, 100]')
+    if args.foxglove is not None and not 0 <= args.foxglove <= 65535:
+        raise BringupError('--foxglove PORT must be in [0, 65535]')
+    with _stderr_silenced():   # pybullet prints its build time when imported
+        from ..ros.sim_node import GROUPS as SIM_GROUPS
+    from ..ros.supervisor import RECORDED
+    unknown = sorted(set(args.record_topics or ()) - set(RECORDED))
+    if unknown:
+        raise BringupError(f'cannot record {unknown}; choose from {list(RECORDED)}')
+    sim = {'world': str(Path(args.world).resolve()), 'rate': args.rate, 'seed': args.seed,
+           'range_noise': args.noise}
+    try:
+        for cls in SIM_GROUPS:
+            build(cls, sim, ignore_unknown=True)
+    except ConfigError as exc:
+        raise BringupError(f'simulator: {one_line(exc)}') from exc
+    for path, option in ((args.record, '--record'), (args.png or f'{world.name}.png', '--png')):
+        if path:
+            _writable_folder(path, option)
+    params = str(Path(args.params).resolve()) if args.params else _default_params()
+    if args.params and not Path(params).exists():
+        raise BringupError(f'--params {args.params}: no such file')
+    if args.params and not Path(params).is_file():
+        raise BringupError(f'--params {args.params}: not a file')
+    values = check_params(params)
+    domain, source = choose_domain(args, environ)
+    method = args.method or values.get('method', METHODS[0])
+    return Plan(world, sim['world'], params, method, domain, source)
 
 
 @dataclass(frozen=True)
@@ -77,6 +249,8 @@ def run_once(world: World, world_path: str, params: str, domain: int, *,
     for name, value in (sim_params or {}).items():
         sim_args += ['-p', f'{name}:={value}']
     timeout = timeout or 2.0 * world.time_limit / rate + 30.0
+    if method is None:
+        method = load_params_file(params).get('method', METHODS[0])
 
     from ..ros.supervisor import Supervisor  # rclpy only after the environment is set
     children: list[subprocess.Popen] = []
@@ -87,7 +261,7 @@ def run_once(world: World, world_path: str, params: str, domain: int, *,
     try:
         children = [start(node, node_args, env, log=log_dir / f'{node.split("_")[0]}.log'
                           if log_dir else None) for node, node_args in nodes.items()]
-        sup = Supervisor(world, record, method or load_config(params).method, record_topics)
+        sup = Supervisor(world, record, method, record_topics)
         outcome = sup.run(children, timeout, names=tuple(nodes))
     except KeyboardInterrupt:   # before the supervisor took over the signals
         outcome = 'interrupted'
@@ -102,41 +276,30 @@ def run_once(world: World, world_path: str, params: str, domain: int, *,
     if sup is None:
         return RunResult(outcome, 0.0, np.zeros((0, 3)), method or '')
     path = np.asarray(sup.path) if sup.path else np.zeros((0, 3))
-    return RunResult(outcome, sup.sim_time, path, sup.method, sup.rss_mib)
+    sim_time = sup.outcome_time if sup.outcome_time is not None else sup.sim_time
+    return RunResult(outcome, sim_time, path, sup.method, sup.rss_mib)
 
 
 def main(argv: list[str] | None = None) -> int:
     args = parse_args(argv)
     try:
-        world = load_world(args.world)
-    except WorldError as exc:
-        print(f'subapf-bringup: {exc}', file=sys.stderr)
+        plan = prepare(args, os.environ)
+    except BringupError as exc:
+        print(f'{PROG}: error: {exc}', file=sys.stderr)
         return 2
-    if not 0.1 <= args.rate <= 100.0:
-        print('subapf-bringup: --rate must be in [0.1, 100]', file=sys.stderr)
-        return 2
-    if args.foxglove is not None and not 0 <= args.foxglove <= 65535:
-        print('subapf-bringup: --foxglove PORT must be in [0, 65535]', file=sys.stderr)
-        return 2
-    if args.domain_id is not None and not 0 <= args.domain_id <= 101:
-        print('subapf-bringup: --domain-id must be in [0, 101]', file=sys.stderr)
-        return 2
-    from ..ros.supervisor import RECORDED
-    unknown = sorted(set(args.record_topics or ()) - set(RECORDED))
-    if unknown:
-        print(f'subapf-bringup: cannot record {unknown}; choose from {list(RECORDED)}',
-              file=sys.stderr)
-        return 2
-    domain = args.domain_id if args.domain_id is not None else random.randint(1, 100)
-    params = str(Path(args.params or default_params_file()).resolve())
-    print(f'subapf-bringup: world {world.name}, domain {domain}, rate {args.rate}x',
-          flush=True)
-    result = run_once(world, str(Path(args.world).resolve()), params, domain,
+    world = plan.world
+    print(f'{PROG}: world {world.name}, domain {plan.domain} ({plan.domain_source}), '
+          f'rate {args.rate}x', flush=True)
+    result = run_once(world, plan.world_path, plan.params, plan.domain,
                       method=args.method, rate=args.rate, seed=args.seed,
                       sim_params={'range_noise': args.noise}, record=args.record,
                       record_topics=args.record_topics, timeout=args.timeout,
                       foxglove_port=args.foxglove)
-    print(f'subapf-bringup: outcome {result.outcome}, simulated time {result.sim_time:.1f} s, '
+    if result.outcome.startswith('failed: ') and 'did not start' in result.outcome:
+        print(f'{PROG}: error: {result.outcome[len("failed: "):]}; its own message is '
+              'above', file=sys.stderr)
+        return 2
+    print(f'{PROG}: outcome {result.outcome}, simulated time {result.sim_time:.1f} s, '
           f'path length {path_length(result.path):.2f} m', flush=True)
     if len(result.path):
         from ..ros.sim_node import TICK

@@ -3,8 +3,9 @@
 ``planner.yaml`` documents every parameter of both nodes (default, unit, range or
 choices, read-only) and is the params file the nodes, ``subapf-bench`` and
 ``subapf-replay`` read. Each robot file holds the planner node's parameters that
-come from one robot (core/robot.py ROBOTS: footprint and the clearances derived
-from it, laser mounting, frame and range, limits, cmd_vel type), loaded after
+come from one robot (core/robot.py ROBOTS: its name as ``robot``, footprint and the
+clearances derived from it, laser mounting, frame and range, limits, cmd_vel type),
+loaded after
 planner.yaml. ``test/test_config.py`` checks the committed files equal what
 :func:`render` and :func:`render_robot` write, so they cannot drift from the code.
 Regenerate with ``python -m subapf_planner.tools.paramdoc config/planner.yaml
@@ -20,11 +21,9 @@ import textwrap
 
 import yaml
 
-from ..core.config import PlannerConfig, robot_fields
-from ..core.loop import Supervision
+from ..core.config import robot_fields
+from ..core.params import describe
 from ..core.robot import ROBOTS, RobotDescription
-from ..sim.faults import ScanFaults
-from ..sim.simulator import SimConfig
 
 HEADER = """\
 # Parameters of the subapf_planner nodes (ROS 2 params file), written by
@@ -40,15 +39,7 @@ HEADER = """\
 
 
 def _comment(f: dataclasses.Field) -> list[str]:
-    m = f.metadata
-    text = m['description'] + (f' [{m["unit"]}]' if m['unit'] else '')
-    if m.get('choices'):
-        text += '; one of: ' + ', '.join(m['choices'])
-    elif m.get('lo') is not None:
-        text += f'; range [{m["lo"]}, {m["hi"]}]'
-    if m.get('read_only'):
-        text += '; read-only'
-    return textwrap.wrap(text + '.', 76, initial_indent='    # ', subsequent_indent='    # ')
+    return textwrap.wrap(describe(f), 76, initial_indent='    # ', subsequent_indent='    # ')
 
 
 def _section(node: str, groups: list[tuple[str, type]]) -> list[str]:
@@ -63,16 +54,12 @@ def _section(node: str, groups: list[tuple[str, type]]) -> list[str]:
 
 def render() -> str:
     """The whole params file."""
-    from ..ros.foxglove_node import FoxgloveOptions
-    from ..ros.planner_node import NodeOptions
-    from ..ros.sim_node import SimNodeOptions
-    planner = _section('subapf_planner', [('node (ros/planner_node.py)', NodeOptions),
-                                          ('supervision (core/loop.py)', Supervision),
-                                          ('planner core (core/config.py)', PlannerConfig)])
-    sim = _section('subapf_sim', [('node (ros/sim_node.py)', SimNodeOptions),
-                                  ('simulator (sim/simulator.py)', SimConfig),
-                                  ('scan faults (sim/faults.py)', ScanFaults)])
-    relay = _section('subapf_foxglove', [('node (ros/foxglove_node.py)', FoxgloveOptions)])
+    from ..ros.foxglove_node import SECTIONS as FOXGLOVE_SECTIONS
+    from ..ros.planner_node import SECTIONS as PLANNER_SECTIONS
+    from ..ros.sim_node import SECTIONS as SIM_SECTIONS
+    planner = _section('subapf_planner', PLANNER_SECTIONS)
+    sim = _section('subapf_sim', SIM_SECTIONS)
+    relay = _section('subapf_foxglove', FOXGLOVE_SECTIONS)
     return HEADER + '\n'.join(planner + [''] + sim + [''] + relay) + '\n'
 
 
@@ -94,7 +81,7 @@ def render_robot(key: str) -> str:
              *textwrap.wrap('Sources: ' + robot.source + '.', 86, initial_indent='# ',
                             subsequent_indent='#   '),
              'subapf_planner:', '  ros__parameters:']
-    for name, value in robot_parameters(robot).items():
+    for name, value in {'robot': key, **robot_parameters(robot)}.items():
         lines.append('    ' + yaml.safe_dump({name: value}, default_flow_style=True,
                                               width=200).strip()[1:-1])
     return '\n'.join(lines) + '\n'
