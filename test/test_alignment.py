@@ -189,7 +189,8 @@ def test_the_scan_goes_into_the_memory_after_the_command_the_same_either_way():
     told, left = DecisionLoop(PlannerConfig()), DecisionLoop(PlannerConfig())
     for ctl in (told, left):
         ctl.set_goal(np.asarray(world.goal, float), in_map=True)
-    sim_cfg = SimConfig(odom_distance_scale=1.02, odom_yaw_scale=1.03)
+    sim_cfg = SimConfig(sensor='ideal', range_noise=0.01, odom_distance_scale=1.02,
+                        odom_yaw_scale=1.03)
     with BurgerSim(world, sim_cfg) as sim:
         start = sim.true_pose()
         for _ in range(30):
@@ -221,7 +222,9 @@ def _drive_between(world, sim_cfg, legs):
     from subapf_planner.core.loop import DecisionLoop
     from subapf_planner.core.status import State
     from subapf_planner.sim.simulator import BurgerSim
-    ctl = DecisionLoop(PlannerConfig(scan_alignment=True))
+    # the planner told the lidar it has (exact rays with 1 cm noise)
+    ctl = DecisionLoop(PlannerConfig(scan_alignment=True, range_noise_floor=0.01,
+                                     range_noise_fraction=0.0))
     goals = [np.asarray(world.goal, float), np.asarray(world.start[:2], float)] * legs
     misses, driven, corrected, odometry = [], 0.0, [], []
     ctl.set_goal(goals[0], in_map=True)
@@ -262,7 +265,8 @@ def test_drifting_odometry_is_corrected_over_60_m_of_a_building():
     from subapf_planner.sim.world import parse_world
     from subapf_planner.sim.worldgen import generate, sub_seed
     world = parse_world(generate('building', sub_seed(2026, 'building', 7), 'building_007'))
-    drift = SimConfig(odom_distance_scale=1.02, odom_yaw_scale=1.03)
+    drift = SimConfig(sensor='ideal', range_noise=0.01, odom_distance_scale=1.02,
+                      odom_yaw_scale=1.03)
     driven, corrected, odometry, misses, collided = _drive_between(world, drift, legs=2)
     assert driven > 60.0 and len(misses) == 4 and not collided
     assert max(misses) <= world.goal_tolerance      # it stops there in truth

@@ -39,7 +39,9 @@ def test_short_bench_writes_consistent_results(tmp_path, worlds_dir):
         straight = 5.0 if r['world'] == 'four_points' else 4.0
         assert r['path_length'] >= straight - r['goal_tolerance'] - 0.05
         assert r['min_clearance'] > 0.1
-        assert r['time_s'] == pytest.approx(r['cycles'] * PAPER.period, abs=PAPER.period)
+        # one cycle per scan delivered: one per sweep but the lidar's lost scans (1 %)
+        sweeps = r['time_s'] / PAPER.period
+        assert 0.95 * sweeps - 1 <= r['cycles'] <= sweeps + 1
         assert r['cycles'] >= 1 and r['plan_ms_p99'] >= r['plan_ms_median'] > 0
     assert (out / 'summary.md').read_text().startswith('| method |')
     assert (out / 'four_points.png').stat().st_size > 10_000

@@ -81,7 +81,8 @@ def args(data: Path, out: Path, readme: Path, *extra: str) -> list[str]:
 
 def bench_doc(runs: list[dict], meta: dict | None = META, **conditions) -> dict:
     doc = {'runs': runs, 'methods': list(dict.fromkeys(r['method'] for r in runs)),
-           'seed': 0, 'noise': 0.01, 'odom_distance_scale': 1.0, 'odom_yaw_scale': 1.0,
+           'seed': 0, 'sensor': 'realistic', 'noise': 0.0, 'odom_distance_scale': 1.0,
+           'odom_yaw_scale': 1.0,
            'wall_time_s': 12.3, **conditions}
     if meta is not None:
         doc['meta'] = meta
@@ -126,7 +127,7 @@ def test_a_results_file_gives_a_row_per_method_with_its_provenance(tmp_path, mon
                  'odometry distance scale 1.02', '10 runs in 12 s wall time',
                  '[tiny.json](results/data/tiny.json)'):
         assert part in line, part
-    assert 'laser noise' not in line   # the default conditions are not repeated
+    assert 'noise' not in line and 'sensor' not in line   # the defaults are not repeated
     # two families: reached per family and method
     assert '| barn (2) | 2 | 0 |' in page and '| maze (3) | 1 | 1 |' in page
     assert page.index('A note after the tables.') > page.index('Produced by')

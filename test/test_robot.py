@@ -62,12 +62,14 @@ def test_urdf_matches_the_description():
 
 def test_simulated_wall_lands_where_the_planners_mounting_puts_it():
     """A wall 2 m ahead seen by the simulator's laser and converted with the planner's
-    default mounting lies on the wall (noise 0.01 m): the two agree on where the laser
-    is. With the mounting off by 0.1 m the same points miss the wall by that much."""
+    default mounting lies on the wall (the ideal sensor, noise 0.01 m): the two agree on
+    where the laser is. With the mounting off by 0.1 m the same points miss the wall by
+    that much."""
     doc = {'name': 'wall', 'start': [0.0, 0.0, 0.3], 'goal': [1.0, 0.0],
            'obstacles': [{'box': {'center': [2.05, 0.0], 'size': [0.1, 6.0]}}]}
     w = parse_world(doc)
-    with BurgerSim(w, SimConfig(seed=1)) as sim:
+    with BurgerSim(w, SimConfig(seed=1, sensor='ideal',
+                                range_noise=0.01)) as sim:
         sim.step(0.2)
         pose, scan = sim.true_pose(), sim.scan()
     ahead = np.abs(np.remainder(scan.angles + pose[2] + math.pi, 2 * math.pi) - math.pi) < 0.5

@@ -174,3 +174,48 @@ def test_deskew_puts_a_bent_sweep_back_on_the_walls(motion):
     assert np.max(_off_walls(pts)) < 0.025 and np.median(_off_walls(pts)) < 0.005
     assert straight.time_increment == 0.0 and straight.stamp == scan.stamp
     assert deskew(scan, np.zeros(3)) is scan
+
+
+@pytest.mark.core
+def test_denoise_averages_along_a_surface_and_keeps_edges_and_lone_returns():
+    """denoise: a wall 2 m ahead through the LDS-01's noise (5 cm sigma there) is left
+    with under half of it; a box in front of the wall keeps its edge (no beam is pulled
+    between the two surfaces), and a lone return between them (a mixed pixel) stays."""
+    from subapf_planner.core.scan import Scan, denoise
+    n = 360
+    angles = np.radians(np.arange(n))
+    rng = np.random.default_rng(3)
+    truth = np.full(n, np.inf)
+    front = (angles > np.radians(-60) + 2 * math.pi) | (angles < np.radians(60))
+    truth[front] = 2.0 / np.cos(np.where(angles[front] > math.pi, angles[front] - 2 * math.pi,
+                                         angles[front]))
+    box = (angles > np.radians(10)) & (angles < np.radians(30))
+    truth[box] = 1.0
+    sigma = 0.025 * np.where(np.isfinite(truth), truth, 0.0)
+    noisy = truth + rng.normal(0.0, 1.0, n) * sigma
+    noisy[np.radians(40).round(3) == angles.round(3)] = 1.5   # a lone return
+    scan = Scan(noisy, 0.0, math.radians(1.0), 0.12, 3.5)
+    out = denoise(scan, 0.0075, 0.025).ranges
+    wall = front & ~box & np.isfinite(truth) & (truth < 3.4)
+    wall &= ~np.isin(np.arange(n), [9, 10, 11, 29, 30, 31, 39, 40, 41])   # next to edges
+    before = np.std(noisy[wall] - truth[wall])
+    assert np.std(out[wall] - truth[wall]) < 0.5 * before
+    assert np.all(np.abs(out[box] - 1.0) < 0.1) and np.all(out[wall] > 1.5)   # edges kept
+    assert out[40] == 1.5                                           # the lone return
+    assert np.array_equal(np.isfinite(out), np.isfinite(noisy))     # no return stays none
+    assert denoise(scan, 0.0, 0.0) is scan                          # no noise: as it is
+
+
+@pytest.mark.sim
+def test_a_static_cluttered_field_through_the_realistic_lidar_has_no_moving_track():
+    """The shipped cluttered field (posts and boxes, nothing moving) through the LDS-01's
+    noise, dropped beams and mixed pixels: the robot reaches the goal and never evades;
+    no cycle takes a piece of the clutter for a mover."""
+    from subapf_planner.core.config import PlannerConfig
+    from subapf_planner.ros.paths import shipped_worlds_dir
+    from subapf_planner.sim.episode import run_episode
+    from subapf_planner.sim.world import load_world
+    world = load_world(shipped_worlds_dir() / 'cluttered_field.yaml')
+    result = run_episode(world, PlannerConfig(), SimConfig(sensor='realistic', seed=4))
+    assert str(result.outcome) == 'reached'
+    assert result.statuses.get('evading', 0) == 0, result.statuses

@@ -89,6 +89,28 @@ def test_a_walker_where_the_memory_saw_free_space_is_known_to_move_sooner():
     assert on_unknown >= MOVE_DISTANCE / 0.22 > on_free
 
 
+def moved_when(standing: bool | None) -> bool:
+    """Whether a cluster whose centroid slides 0.6 m over 4 s (what noise, dropped beams
+    and mixed pixels do to a box's visible side) is ever taken to move, its returns
+    on obstacles that have stood (True), on none (False) or not told (None)."""
+    tr = Tracker(0.15, 1.2, 0.6, 0.04)
+    seen = False
+    for k in range(21):
+        pts = disc_points((2.0 + 0.03 * k, 1.0), 0.25)
+        told = None if standing is None else np.full(len(pts), standing)
+        seen |= bool(tr.update(pts, 0.2 * k, np.zeros(len(pts)), told).moving.any())
+    return seen
+
+
+def test_a_cluster_on_what_has_long_stood_never_moves_whatever_its_centroid_does():
+    """The tracker's ghost rule (HELD_UP_FRACTION of a cluster on obstacles standing
+    STANDING_SCANS scans): the same sliding centroid is a mover when its returns are
+    not on such obstacles (a walker) and never when they are (static clutter seen
+    through a real lidar)."""
+    assert moved_when(None) and moved_when(False)
+    assert not moved_when(True)
+
+
 def test_people_side_by_side_on_seen_free_cells_are_tracked_a_wall_is_not():
     """Two walkers shoulder to shoulder (one cluster 1.5 m long: longer than
     max_mover_size) on cells the memory saw free are tracked and found moving; the same

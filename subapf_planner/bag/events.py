@@ -4,7 +4,12 @@ Both replays (in-process, ros/replay.py, and through a planner_node over DDS,
 ros/replay_dds.py) read a bag through :func:`events`, so they see the same
 events at the same simulated times in the same order:
 
-* ``scan`` and ``odom`` at their header stamps;
+* ``odom`` at its header stamp;
+* ``scan`` at its header stamp or, when older, at the newest simulated time seen
+  before it in the bag, after the commands logged before it at that time: a real
+  lidar's scan is stamped at its first beam and arrives a sweep and the driver's
+  latency later (so does the simulator's realistic sensor's), and the node could plan
+  with it only from the first tick after it arrived;
 * ``goal`` (PoseStamped; RViz and the bringup leave its stamp at zero) at the
   newest simulated time seen before it in the bag;
 * ``cmd_vel`` at its header stamp when it is a TwistStamped (the node stamps each
@@ -93,9 +98,16 @@ def events(path: str | Path, names: dict[str, str]) -> list[Event]:
         if r is None:   # /clock: only a time source
             now = max(now, stamp_ns(m.message.clock))
             continue
-        if r in ('scan', 'odom'):
+        if r == 'odom':
             t = stamp_ns(m.message.header.stamp)
             now = max(now, t)
+        elif r == 'scan' and stamp_ns(m.message.header.stamp) < now:
+            # arrived late: at the newest time, after the commands logged before it
+            out.append((now, _RANK['cmd_vel'], i, Event(now, r, m.message)))
+            continue
+        elif r == 'scan':
+            t = stamp_ns(m.message.header.stamp)
+            now = t
         elif r == 'cmd_vel' and m.type_name == STAMPED_CMD:
             t = stamp_ns(m.message.header.stamp)
         else:   # goal, Twist command

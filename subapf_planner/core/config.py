@@ -152,13 +152,13 @@ class PlannerConfig:
                                  'and the memory, the field and the goal live in the '
                                  'corrected frame (with the geodesic attraction; '
                                  'docs/alignment.md). Switching it starts an empty map')
-    alignment_gain: float = param(1.0, "Fraction of an accepted match's correction taken "
-                                  "at each scan (below 1: the matcher's noise averaged "
-                                  'over several scans)', '', 0.01, 1.0)
     range_noise_floor: float = param(0.0075, "The lidar's range noise (standard deviation) "
-                                     'near it: the scan alignment weighs each return by '
-                                     'its noise (LDS-01: +/-15 mm below 0.5 m, taken as '
-                                     '2 sigma)', 'm', 0.0, 1.0)
+                                     'near it: each scan is averaged along its surfaces '
+                                     'by it (core/scan.py denoise), the scan alignment '
+                                     'weighs each return by it, the tracker looks that '
+                                     'far along a ray for what has stood (LDS-01: '
+                                     '+/-15 mm below 0.5 m, taken as 2 sigma; 0 and 0: '
+                                     'no averaging)', 'm', 0.0, 1.0)
     range_noise_fraction: float = param(0.025, '... and as a fraction of the range farther '
                                         'out (LDS-01: +/-5 % from 0.5 to 3.5 m, 2 sigma)',
                                         '', 0.0, 1.0)

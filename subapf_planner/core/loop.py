@@ -31,7 +31,7 @@ from .occupancy import OccupancyGrid
 from .params import check_fields, param
 from .planner import Planner
 from .robot import compose, invert
-from .scan import Scan, deskew
+from .scan import Scan, denoise, deskew
 from .status import State, Status
 from .supervisors import SUPERVISORS, Recoveries
 
@@ -257,10 +257,14 @@ class DecisionLoop:
         return np.asarray(compose(invert(start), end))
 
     def _deskewed(self, scan: Scan) -> Scan:
-        """The scan as if taken at its first beam's instant (core/scan.py deskew), once
-        per scan."""
+        """The scan as if taken at its first beam's instant (core/scan.py deskew), its
+        ranges' noise averaged along each surface (core/scan.py denoise, by the lidar's
+        range_noise_*), once per scan."""
         if self._deskew is None or self._deskew[0] is not scan:
-            self._deskew = (scan, deskew(scan, self.sweep_motion(scan), self.cfg.laser_mount))
+            cfg = self.cfg
+            straight = deskew(scan, self.sweep_motion(scan), cfg.laser_mount)
+            self._deskew = (scan, denoise(straight, cfg.range_noise_floor,
+                                          cfg.range_noise_fraction))
         return self._deskew[1]
 
     def silent(self, now: float) -> tuple[bool, bool]:

@@ -32,7 +32,7 @@ from numpy.typing import ArrayLike, NDArray
 from .alignment import DistanceField, Match, align, distance_field
 from .config import PlannerConfig
 from .navigation import NavigationField, compute_field
-from .occupancy import OccupancyGrid
+from .occupancy import ESTABLISHED, NOT_ESTABLISHED, OccupancyGrid
 from .robot import compose, to_parent
 from .scan import Scan
 from .tracking import clusters
@@ -261,6 +261,34 @@ class NavigationMemory:
         inside = self.grid.inside(cells)
         out = np.zeros(len(cells), np.float32)
         out[inside] = self.grid.log_odds[cells[inside, 0], cells[inside, 1]]
+        return out
+
+    def standing(self, points: ArrayLike, origin: ArrayLike, reach: ArrayLike,
+                 scans: int) -> NDArray[np.bool_]:
+        """Per laser return (n, 2) [m], taken from ``origin`` (x, y): whether a cell within
+        ``reach`` (n,) [m] of it along its ray (the range's noise) has been an established
+        obstacle for ``scans`` scans or more (OccupancyGrid.established_at; without it, as
+        without the scan alignment, established at all). A return that noise put in front
+        of a wall, on cells its own rays saw free, or behind it, on cells never seen, is
+        still on the wall; a walker's returns are not on what has stood that long."""
+        points = np.asarray(points, float).reshape(-1, 2)
+        out = np.zeros(len(points), bool)
+        if not len(points):
+            return out
+        g = self.grid
+        ray = points - np.asarray(origin, float)[:2]
+        unit = ray / np.maximum(np.hypot(*ray.T), 1e-9)[:, None]
+        reach = np.broadcast_to(np.asarray(reach, float), (len(points),))
+        for k in (-1.0, -0.5, 0.0, 0.5, 1.0):
+            cells = g.cell_of(points + (k * reach)[:, None] * unit)
+            inside = g.inside(cells)
+            r, c = cells[inside, 0], cells[inside, 1]
+            if g.established_at is None:
+                old = g.log_odds[r, c] >= ESTABLISHED
+            else:
+                since = g.established_at[r, c].astype(np.int64)
+                old = (since != NOT_ESTABLISHED) & (g.scans - since >= scans)
+            out[np.flatnonzero(inside)[old]] = True
         return out
 
     def _covers(self, position: np.ndarray) -> bool:

@@ -48,7 +48,7 @@ from .robot import compose, invert, to_parent
 from .sampling import clearance
 from .scan import Scan, ScanError, scan_to_points
 from .status import Status
-from .tracking import NO_TRACKS, Tracker, Tracks
+from .tracking import NO_TRACKS, STANDING_SCANS, Tracker, Tracks
 
 __all__ = ['Perception', 'PlanResult', 'Planner', 'goal_status', 'input_status',
            'local_radius', 'plan']
@@ -214,7 +214,7 @@ class Planner:
         except ScanError:
             return self._stop(PlanResult(Command(0.0, 0.0, Status.INVALID_SCAN)))
         points = to_parent(scan_pose, base)   # the returns in base_footprint, then placed
-        tracks, transient = self._track(scan, points, now)
+        tracks, transient = self._track(scan, points, scan_pose, now)
         if cfg.geodesic:   # the memory takes the scan in once the command is out
             self._perception = Perception(scan, base, odom_scan_pose, goal, transient,
                                           tracks.trail)
@@ -291,11 +291,6 @@ class Planner:
         moved = compose(invert(last), scan_pose)   # odometry's motion since the last scan
         pose = within_drift(predicted, self.match.pose, math.hypot(moved[0], moved[1]),
                             moved[2])
-        gain = self.cfg.alignment_gain
-        if gain < 1.0:
-            step = pose - predicted
-            step[2] = math.remainder(step[2], 2 * math.pi)
-            pose = predicted + gain * step
         if not np.array_equal(pose, predicted):
             self.correction = compose(pose, invert(scan_pose))
 
@@ -321,13 +316,22 @@ class Planner:
             self._goal = (goal.copy(), to_parent(self.correction, goal)[0])
         return self._goal[1]
 
-    def _track(self, scan: Scan, points: NDArray,
+    def _track(self, scan: Scan, points: NDArray, scan_pose: NDArray,
                now: float) -> tuple[Tracks, NDArray[np.bool_] | None]:
-        """The tracks of this scan, and per beam whether it returned from a moving one."""
+        """The tracks of this scan (its returns ``points`` in the memory's frame, taken
+        at ``scan_pose``), and per beam whether it returned from a moving one. The
+        tracker is told which returns are on what has stood for STANDING_SCANS scans,
+        within two standard deviations of their range noise along their rays
+        (NavigationMemory.standing)."""
         t = scan.stamp if math.isfinite(scan.stamp) else now
         if not self.cfg.tracks_moving or not math.isfinite(t):
             return NO_TRACKS, None
-        tracks = self.tracker.update(points, t, self.memory.log_odds_at(points))
+        origin = compose(scan_pose, self.cfg.laser_mount)[:2]
+        noise = np.maximum(self.cfg.range_noise_floor, self.cfg.range_noise_fraction
+                           * np.hypot(*(points - origin).T))
+        tracks = self.tracker.update(points, t, self.memory.log_odds_at(points),
+                                     self.memory.standing(points, origin, 2.0 * noise,
+                                                          STANDING_SCANS))
         transient = np.zeros(np.size(scan.ranges), bool)
         transient[np.flatnonzero(scan.valid(self.cfg.obstacle_range))] = tracks.held_points
         return tracks, transient

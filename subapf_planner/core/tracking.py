@@ -89,6 +89,14 @@ WALL_LOG_ODDS = ESTABLISHED
 WALL_FRACTION = 0.5
 
 
+#: A cluster with this fraction of its points on obstacles that have stood STANDING_SCANS
+#: scans or more (5 s at the LDS-01's 5 Hz; NavigationMemory.standing) stands where
+#: something stood long before it: it is not moving, whatever its centroid does. A walker
+#: leaves such cells within a few scans; a person who stood there and walks off, too.
+HELD_UP_FRACTION = 0.5
+STANDING_SCANS = 10
+
+
 @dataclass(frozen=True)
 class Tracks:
     """The tracks after a scan: position (n, 2) [m] and velocity (n, 2) [m/s] in odom,
@@ -177,7 +185,8 @@ class Tracker:
     """Tracks of one robot. Not thread-safe."""
 
     #: Per-track arrays, one row per track, appended and filtered together.
-    PER_TRACK = ('x', 'P', 'hits', 'misses', 'new_age', 'radius', 'ids', 'first', 'went')
+    PER_TRACK = ('x', 'P', 'hits', 'misses', 'new_age', 'radius', 'ids', 'first', 'went',
+                 'moved')
 
     def __init__(self, gap: float, max_size: float, gate: float, moving_speed: float) -> None:
         self.gap, self.max_size, self.gate, self.moving_speed = gap, max_size, gate, moving_speed
@@ -194,6 +203,7 @@ class Tracker:
         self.ids = np.zeros(0, np.int64)
         self.first = np.zeros((0, 2))   # where each track was first seen [m]
         self.went = np.zeros(0)          # the farthest it has been from there [m]
+        self.moved = np.zeros(0, bool)   # whether it moved at the last scan it was seen
         self._next_id = 0
         #: (track ids, points) of the last TRAIL_SCANS scans
         self._history: list[tuple[NDArray[np.int64], NDArray[np.float64]]] = []
@@ -233,9 +243,12 @@ class Tracker:
         self.P[rows] = cov - gain @ cov[:, :2, :]
 
     def update(self, points: NDArray[np.float64], t: float,
-               log_odds_at: NDArray[np.float64]) -> Tracks:
+               log_odds_at: NDArray[np.float64],
+               standing: NDArray[np.bool_] | None = None) -> Tracks:
         """Take a scan's obstacle points (n, 2) at time ``t`` [s] with the memory's log
-        odds at each (n,; 0 off the map), before the scan is written; returns the tracks.
+        odds at each (n,; 0 off the map) and whether each is on an obstacle that has stood
+        STANDING_SCANS scans (n,; none when not given), before the scan is written;
+        returns the tracks.
         A scan at the same time as the last is not taken again (the tracks stand)."""
         if self.time is not None and t == self.time and self._last is not None:
             return self._last   # the same scan again (a tick without a new one)
@@ -248,6 +261,9 @@ class Tracker:
             self._predict(dt)
         labels, count = clusters(points, self.gap)
         cents, sizes, new, mapped, thin = _cluster_features(points, labels, count, log_odds_at)
+        held_up = np.zeros(count, bool) if standing is None or not count else \
+            np.bincount(labels, standing, count) / np.bincount(labels, minlength=count) \
+            >= HELD_UP_FRACTION
         # walls are not tracked: long clusters (but up to NEW_SIZE_FACTOR times as long
         # where the memory saw free space: people side by side, or one close enough to
         # show their whole width), straight ones, those on the map's established obstacles
@@ -280,7 +296,7 @@ class Tracker:
                          misses=np.zeros(m, np.int64),
                          new_age=np.where(new[fresh] >= NEW_FRACTION, 0, -1).astype(np.int64),
                          radius=np.zeros(m), ids=self._next_id + np.arange(m),
-                         first=cents[fresh], went=np.zeros(m))
+                         first=cents[fresh], went=np.zeros(m), moved=np.zeros(m, bool))
             self._next_id += m
         keep = self.misses <= MAX_MISSES
         remap = np.cumsum(keep) - 1
@@ -292,7 +308,19 @@ class Tracker:
         speed = np.hypot(self.x[:, 2], self.x[:, 3])
         self.went = np.maximum(self.went, np.hypot(*(self.x[:, :2] - self.first).T))
         went = np.where(self.new_age >= 0, NEW_MOVE_DISTANCE, MOVE_DISTANCE)
-        moving = (self.hits >= MIN_HITS) & (speed >= self.moving_speed) & (self.went >= went)
+        # where the memory has obstacles under (most of) its points, it stands on what
+        # the robot has seen stand there: it does not move, whatever its centroid does
+        # (the visible side of clutter changes as the robot drives; noise, dropped beams
+        # and mixed pixels at its edges move its centroid); one that moved keeps moving
+        # until it stands on such cells (a walker passing close to a wall)
+        free = np.zeros(len(self.x), bool)
+        free[track_of[visible]] = ~held_up[visible]
+        unseen = np.ones(len(self.x), bool)
+        unseen[track_of[visible]] = False
+        free |= unseen & self.moved
+        moving = (self.hits >= MIN_HITS) & (speed >= self.moving_speed) \
+            & (self.went >= went) & free
+        self.moved = moving.copy()
         held = moving | ((self.new_age >= 0) & (self.new_age < NEW_OBJECT_SCANS))
         point_track = track_of[labels] if count else np.zeros(0, np.int64)
         # held[id] by track id; the last slot (id -1: a point of no track) stays False

@@ -48,23 +48,22 @@ INPUT_SETTLE = 0.01
 
 def _instants(stream: list[Event]) -> list[tuple[int, list[Event], list[Event]]]:
     """[(t [ns], inputs, recorded commands)] from the bag's events, one per simulated
-    time, from the first recorded command on."""
-    cmd_times = [e.time_ns for e in stream if e.role == 'cmd_vel']
-    if not cmd_times:
+    time, from the first recorded command on; an input that came after a time's
+    commands (a scan that arrived late, bag/events.py) gets an instant of its own at that
+    time, without commands: it is handed over after the tick."""
+    first_cmd = next((k for k, e in enumerate(stream) if e.role == 'cmd_vel'), None)
+    if first_cmd is None:
         return []
     # Before its first command the recorded node only collected inputs (and may have
     # missed some while discovery settled): hand them all over, the newest goal
     # first, then tick at t0.
-    t0 = cmd_times[0]
-    early = [e for e in stream if e.time_ns <= t0 and e.role != 'cmd_vel']
+    t0 = stream[first_cmd].time_ns
+    early = stream[:first_cmd]
     goals = [e for e in early if e.role == 'goal']
-    first = (t0, goals[-1:] + [e for e in early if e.role != 'goal'],
-             [e for e in stream if e.time_ns == t0 and e.role == 'cmd_vel'])
-    instants = [first]
-    for e in stream:
-        if e.time_ns <= t0:
-            continue
-        if instants[-1][0] != e.time_ns:
+    instants = [(t0, goals[-1:] + [e for e in early if e.role != 'goal'], [])]
+    for e in stream[first_cmd:]:
+        t, inputs, cmds = instants[-1]
+        if t != e.time_ns or (e.role != 'cmd_vel' and cmds):
             instants.append((e.time_ns, [], []))
         instants[-1][2 if e.role == 'cmd_vel' else 1].append(e)
     return instants

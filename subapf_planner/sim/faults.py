@@ -36,7 +36,7 @@ class ScanFaults:
     scan_dropout: float = param(0.0, 'Probability that a scan never reaches the planner', '',
                                 0.0, 0.99, read_only=True)
     scan_latency: float = param(0.0, 'Scans reach the planner this long after capture', 's',
-                                0.0, 5.0, read_only=True)
+                                0.0, 10.0, read_only=True)
     scan_jitter: float = param(0.0, 'Standard deviation of a further delay (half-normal)',
                                's', 0.0, 1.0, read_only=True)
 

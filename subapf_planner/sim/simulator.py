@@ -78,10 +78,10 @@ class SimConfig:
                             read_only=True)
     range_min: float = param(0.12, 'Lidar minimum range', 'm', 0.0, 1.0, read_only=True)
     range_max: float = param(3.5, 'Lidar maximum range', 'm', 0.1, 100.0, read_only=True)
-    sensor: str = param('ideal', 'Lidar model: ideal (exact rays at one instant, plus '
-                        'range_noise and beam_dropout) or realistic (the datasheet errors '
-                        'of `lidar`, each beam at its own instant of the sweep, latency and '
-                        'lost scans: sim/sensor.py)', choices=('ideal', 'realistic'),
+    sensor: str = param('realistic', 'Lidar model: realistic (the datasheet errors of '
+                        '`lidar`, each beam at its own instant of the sweep, latency and '
+                        'lost scans: sim/sensor.py) or ideal (exact rays at one instant, '
+                        'plus range_noise and beam_dropout)', choices=('ideal', 'realistic'),
                         read_only=True)
     lidar: str = param('lds01', "Whose datasheet the realistic sensor follows (the burger's "
                        'LDS-01; sim/sensor.py LIDARS)', choices=tuple(LIDARS), read_only=True)

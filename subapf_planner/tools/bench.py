@@ -51,7 +51,7 @@ DEFAULT_METHODS = ('subharmonic_sampling:geodesic', 'subharmonic_sampling:euclid
                    'dwa:euclidean', 'dwa:geodesic')
 FIELDS = ('geodesic', 'euclidean')
 #: --faults: the four faults the bench has long had, on top of the sensor model.
-FOUR_FAULTS = {'beam_dropout': 0.2, 'scan_dropout': 0.2, 'scan_latency': 0.1}
+FOUR_FAULTS = {'noise': 0.03, 'beam_dropout': 0.2, 'scan_dropout': 0.2, 'scan_latency': 0.1}
 #: How long --cluster waits for its scheduler [s].
 CLUSTER_CONNECT_TIMEOUT = 30.0
 
@@ -295,13 +295,13 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
                    "scheduler's address, e.g. tcp://scheduler:8786 (every worker needs "
                    'subapf_planner installed; --jobs is not used; plots are drawn here)')
     p.add_argument('--seed', type=int, default=0, help='simulator seed (noise)')
-    p.add_argument('--sensor', choices=('ideal', 'realistic'), default='ideal',
-                   help='the lidar: ideal (exact rays at one instant, delivered at once, with '
-                   "--noise; the default) or realistic (the LDS-01's datasheet errors, each "
-                   'beam at its own instant, latency and lost scans: sim/sensor.py)')
-    p.add_argument('--noise', type=float, default=0.01,
-                   help='laser range noise sigma on top of the sensor [m] (Gazebo '
-                   'TurtleBot3: 0.01)')
+    p.add_argument('--sensor', choices=('ideal', 'realistic'), default='realistic',
+                   help="the lidar: realistic (the default: the LDS-01's datasheet errors, "
+                   'each beam at its own instant, latency and lost scans: sim/sensor.py) or '
+                   'ideal (exact rays at one instant, delivered at once; add --noise 0.01 '
+                   "for Gazebo's TurtleBot3)")
+    p.add_argument('--noise', type=float, default=0.0,
+                   help='laser range noise sigma on top of the sensor [m]')
     p.add_argument('--beam-dropout', type=float, default=0.0,
                    help='extra fraction of dropped beams on top of the sensor')
     p.add_argument('--odom-scale', type=float, default=1.0,
@@ -335,8 +335,7 @@ def main(argv: list[str] | None = None) -> int:
             for name, value in FOUR_FAULTS.items():
                 if getattr(args, name) == 0.0:
                     setattr(args, name, value)
-            if args.noise == 0.01:
-                args.noise = 0.03
+
         sim_cfg = SimConfig(seed=args.seed, sensor=args.sensor, range_noise=args.noise,
                             beam_dropout=args.beam_dropout,
                             odom_distance_scale=args.odom_scale,

@@ -43,7 +43,8 @@ DEFAULT_HEADLINE = (('subharmonic_sampling:geodesic', 'the default'),
                     ('subharmonic_sampling:euclidean', "the paper's method"),
                     ('dwa:euclidean', 'DWA'))
 #: results.json's simulator settings and their defaults (printed when not the default).
-CONDITIONS = (('seed', 0, 'simulator seed {}'), ('noise', 0.01, 'laser noise {} m'),
+CONDITIONS = (('seed', 0, 'simulator seed {}'), ('sensor', 'realistic', 'the {} sensor'),
+              ('noise', 0.0, 'extra laser noise {} m'),
               ('beam_dropout', 0.0, 'beams dropped {}'),
               ('scan_dropout', 0.0, 'scans lost {}'),
               ('scan_latency', 0.0, 'scans {} s late'),
@@ -57,10 +58,12 @@ tool), not this page; `subapf-results --check` fails when the two disagree. -->
 
 Benchmark results of the package, one section per suite of worlds. Every run steps
 the simulator and the node's decision loop in one process on simulated time
-(`subapf-bench`, [sim/episode.py](../subapf_planner/sim/episode.py)); laser noise
-sigma 0.01 m as the Gazebo TurtleBot3, simulator seed 0 unless a table says
-otherwise. Each table names the command that produced it, the package version and the
-git commit (`-dirty`: with changes not committed), and the date.
+(`subapf-bench`, [sim/episode.py](../subapf_planner/sim/episode.py)) through the
+realistic lidar (the LDS-01's datasheet noise, dropped beams, mixed pixels, sweeps
+over 0.2 s, latency and lost scans: [worlds.md](worlds.md#simulator)), simulator seed
+0, unless a table says otherwise. Each table names the command that produced it, the
+package version and the git commit (`-dirty`: with changes not committed), and the
+date.
 
 Methods carry their attraction: `subharmonic_sampling:geodesic` is the package's
 default (memory and navigation field, [design](design.md)),
@@ -121,7 +124,9 @@ def load_runset(path: Path) -> RunSet:
     methods = doc.get('methods') or list(dict.fromkeys(r['method'] for r in runs))
     return RunSet(name=path.name, runs=runs, methods=list(methods),
                   meta=doc.get('meta') or {},
-                  conditions={k: doc[k] for k, _, _ in CONDITIONS if k in doc},
+                  # a bench's file from before the sensor was recorded: the ideal one
+                  conditions={k: doc[k] for k, _, _ in CONDITIONS if k in doc}
+                  | ({'sensor': doc.get('sensor', 'ideal')} if 'noise' in doc else {}),
                   wall_time_s=doc.get('wall_time_s'))
 
 
