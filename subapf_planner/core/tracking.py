@@ -90,8 +90,8 @@ WALL_FRACTION = 0.5
 
 
 #: A cluster with this fraction of its points on obstacles that have stood STANDING_SCANS
-#: scans or more (5 s at the LDS-01's 5 Hz; NavigationMemory.standing) stands where
-#: something stood long before it: it is not moving, whatever its centroid does. A walker
+#: scans or more (2 s at the LDS-01's 5 Hz; NavigationMemory.standing) stands where
+#: something has stood for a while: it is not moving, whatever its centroid does. A walker
 #: leaves such cells within a few scans; a person who stood there and walks off, too.
 HELD_UP_FRACTION = 0.5
 STANDING_SCANS = 10
