@@ -217,3 +217,24 @@ def test_bench_records_how_its_results_were_produced():
     if (REPO / '.git').exists():
         assert re.fullmatch(r'[0-9a-f]{7,40}(-dirty)?', meta['commit'])
         assert meta['version'] == setup_version()
+
+
+@core
+def test_the_pose_error_and_the_ghosts_are_reported_where_recorded():
+    """The perception table: per method that records a pose error, its median, p95 and
+    share within 0.10 m at arrival, and the evading cycles of runs in worlds where
+    nothing moves (a moving world's evading is not counted); nothing for a method that
+    plans in odom (pose error 0) or for files from before the bench recorded it."""
+    seen = [dict(r, pose_error_final=e, cycles=100, evading_cycles=k, moving_world=mv)
+            for r, e, k, mv in zip(RUNS[:5], (0.02, 0.04, 0.06, 0.2, 0.08),
+                                   (0, 3, 0, 50, 1), (False, False, False, True, False),
+                                   strict=True)]
+    blind = [dict(r, pose_error_final=0.0, cycles=100, evading_cycles=0, moving_world=False)
+             for r in RUNS[5:]]
+    rs = results.load_runset_doc(bench_doc(seen + blind), 'x.json')
+    table = results.perception_table(rs)
+    rows = [x for x in table.splitlines() if x.startswith('| `')]
+    assert len(rows) == 1 and rows[0].startswith('| `a:geodesic` | 0.060 | ')
+    assert '| 80 % |' in rows[0] and '1.00 % (most 3)' in rows[0]   # 4 of 5; 4 in 400
+    plain = results.load_runset_doc(bench_doc(RUNS), 'y.json')
+    assert results.perception_table(plain) == ''

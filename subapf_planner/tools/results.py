@@ -115,7 +115,12 @@ class Suite:
 def load_runset(path: Path) -> RunSet:
     """A bench's results.json: the object ``subapf-bench`` writes (``meta``, ``runs``,
     ``methods``, the simulator settings), or a bare list of run records."""
-    doc = json.loads(path.read_text())
+    return load_runset_doc(json.loads(path.read_text()), path)
+
+
+def load_runset_doc(doc: object, path: Path | str) -> RunSet:
+    """load_runset of a results file's parsed ``doc`` (``path``: its name)."""
+    path = Path(path)
     if isinstance(doc, list):
         doc = {'runs': doc}
     if not isinstance(doc, dict) or not isinstance(doc.get('runs'), list):
@@ -195,6 +200,31 @@ def methods_table(rs: RunSet) -> str:
         if runs:
             lines.append(method_row(m, runs))
     return '\n'.join(lines)
+
+
+def perception_table(rs: RunSet) -> str:
+    """Per method that uses the memory's frame (a pose error recorded), the planned-from
+    pose against the truth at arrival (median, p95, within 0.10 m) and the cycles spent
+    evading in worlds where nothing moves (share, most in a run); '' when no run records
+    them (results files from before the bench did)."""
+    lines = []
+    for m in rs.methods:
+        runs = [r for r in rs.runs if r['method'] == m]
+        err = [r['pose_error_final'] for r in runs if r.get('pose_error_final') is not None]
+        if not err or max(err) == 0.0:
+            continue
+        still = [r for r in runs if not r.get('moving_world') and 'evading_cycles' in r]
+        evading = [r['evading_cycles'] for r in still]
+        cycles = sum(r['cycles'] for r in still)
+        share = '-' if not cycles else \
+            f'{100.0 * sum(evading) / cycles:.2f} % (most {max(evading)})'
+        lines.append(f'| `{m}` | {_median(err):.3f} | {np.percentile(err, 95):.3f} | '
+                     f'{100.0 * np.mean(np.asarray(err) <= 0.10):.0f} % | {share} |')
+    if not lines:
+        return ''
+    return '\n'.join(['| method | pose error at arrival, median [m] | p95 [m] | within '
+                      '0.10 m | evading cycles where nothing moves |', '|' + '---|' * 5,
+                      *lines])
 
 
 def worlds_table(rs: RunSet) -> str:
@@ -301,6 +331,9 @@ def render_page(suites: list[Suite], methods: list[tuple[str, str]]) -> str:
                 parts.append(f'### {rs.name}\n')
             parts.append(methods_table(rs) + '\n')
             parts.append(provenance(rs) + '\n')
+            seen = perception_table(rs)
+            if seen:
+                parts.append(seen + '\n')
             extra = worlds_table(rs)
             if extra:
                 parts.append(extra + '\n')
