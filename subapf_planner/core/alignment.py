@@ -54,6 +54,7 @@ from scipy import ndimage
 
 from .occupancy import ESTABLISHED
 from .robot import to_parent
+from .scan import range_sigma
 from .tracking import extents
 
 #: A piece of the scan no longer than a mover (a person, a chair, a post) is matched only
@@ -316,8 +317,7 @@ def align(base_points: NDArray[np.float64], predicted: NDArray[np.float64],
     # each return weighed by its range's noise (``noise``: the lidar's floor [m] and
     # fraction of the range), on top of the map's own (RETURN_SIGMA); a noisy far
     # return may lie farther from its wall
-    sigma = np.hypot(RETURN_SIGMA, np.maximum(noise[0], noise[1] * np.hypot(
-        *base_points.T)))
+    sigma = np.hypot(RETURN_SIGMA, range_sigma(np.hypot(*base_points.T), *noise))
     weight_all = sigma ** -2
     reach = np.maximum(MAX_CORRESPONDENCE, 2.0 * sigma)
     for _ in range(ITERATIONS):

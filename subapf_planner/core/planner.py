@@ -46,7 +46,7 @@ from .pipeline import Pipeline
 from .proposers import local_radius
 from .robot import compose, invert, to_parent
 from .sampling import clearance
-from .scan import Scan, ScanError, scan_to_points
+from .scan import Scan, ScanError, range_sigma, scan_to_points
 from .status import Status
 from .tracking import NO_TRACKS, STANDING_SCANS, Tracker, Tracks
 
@@ -327,8 +327,8 @@ class Planner:
         if not self.cfg.tracks_moving or not math.isfinite(t):
             return NO_TRACKS, None
         origin = compose(scan_pose, self.cfg.laser_mount)[:2]
-        noise = np.maximum(self.cfg.range_noise_floor, self.cfg.range_noise_fraction
-                           * np.hypot(*(points - origin).T))
+        noise = range_sigma(np.hypot(*(points - origin).T), self.cfg.range_noise_floor,
+                            self.cfg.range_noise_fraction)
         tracks = self.tracker.update(points, t, self.memory.log_odds_at(points),
                                      self.memory.standing(points, origin, 2.0 * noise,
                                                           STANDING_SCANS))

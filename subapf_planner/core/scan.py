@@ -140,6 +140,12 @@ def deskew(scan: Scan, motion: ArrayLike, mount: ArrayLike = (0.0, 0.0, 0.0)) ->
                 scan.stamp, 0.0, scan.scan_time)
 
 
+def range_sigma(ranges: ArrayLike, floor: float, fraction: float) -> NDArray[np.float64]:
+    """The lidar's range noise (standard deviation) [m] at ``ranges`` [m]: ``floor`` near
+    it, ``fraction`` of the range farther out (PlannerConfig.range_noise_*)."""
+    return np.maximum(floor, fraction * np.asarray(ranges, float))
+
+
 def denoise(scan: Scan, floor: float, fraction: float, half_window: int = 3) -> Scan:
     """The scan with each return moved along its ray onto the line through it and its
     neighbours on the same surface: up to ``half_window`` beams on either side, valid, no
@@ -163,7 +169,7 @@ def denoise(scan: Scan, floor: float, fraction: float, half_window: int = 3) -> 
     a = scan.angles
     ux, uy = np.cos(a), np.sin(a)
     x, y = rr * ux, rr * uy
-    sigma = np.maximum(floor, fraction * rr)
+    sigma = range_sigma(rr, floor, fraction)
     full = n * scan.angle_increment >= 2.0 * math.pi - 0.5 * scan.angle_increment
     count = hit.astype(float)
     sx, sy, sxx, syy, sxy = x * count, y * count, x * x * count, y * y * count, x * y * count

@@ -335,7 +335,6 @@ def main(argv: list[str] | None = None) -> int:
             for name, value in FOUR_FAULTS.items():
                 if getattr(args, name) == 0.0:
                     setattr(args, name, value)
-
         sim_cfg = SimConfig(seed=args.seed, sensor=args.sensor, range_noise=args.noise,
                             beam_dropout=args.beam_dropout,
                             odom_distance_scale=args.odom_scale,
