@@ -9,8 +9,12 @@ import numpy as np
 import pytest
 
 from subapf_planner.core.scan import (
+    GRAZING_MEMORY,
+    GRAZING_OBSTACLES,
+    MAX_SWEEP,
     Scan,
     ScanError,
+    denoise,
     scan_to_points,
     valid_beams,
     voxel_downsample,
@@ -81,3 +85,43 @@ def test_geometry_warning_survives_a_denormal_increment():
     the node fuzz) is reported, not a crash."""
     from subapf_planner.core.scan import geometry_warning
     assert 'too small' in geometry_warning(2, 1.0, 0.0, 2.2e-309)
+
+
+@pytest.mark.parametrize('increment, expected', [
+    (0.2 / 360, 0.2 / 360),   # an LDS-01 sweep
+    (0.0, 0.0), (-1e-3, 0.0), (math.nan, 0.0), (math.inf, 0.0),
+    (1.0, 0.0),               # 360 s for a sweep: not a sweep
+])
+def test_beam_interval_is_a_sweep_s_or_nothing(increment, expected):
+    """A driver's time_increment dates the beams only when it describes a sweep: NaN,
+    negative or a sweep longer than MAX_SWEEP is taken as a scan taken at once."""
+    scan = Scan(np.ones(360), 0.0, 2 * math.pi / 360, 0.1, 10.0, 0.0, increment, 0.2)
+    assert scan.beam_interval == expected
+    assert 359 * scan.beam_interval <= MAX_SWEEP
+
+
+def test_denoise_leaves_grazing_returns_to_the_memory():
+    """Exact returns from a crenellated wall (5 cm teeth every 10 cm) 1 m away, the
+    planner expecting the LDS-01's noise. Where the rays meet the wall at more than 45
+    degrees from its normal, lines fitted across seven beams span several teeth: the
+    obstacles' bound (GRAZING_OBSTACLES) moves these exact returns by centimetres, the
+    memory's (GRAZING_MEMORY) by millimetres. (Moved by centimetres as the robot drives
+    past, the memory's walls drew the drive 1 % long:
+    test_alignment.py::test_stepped_walls_do_not_stretch_the_drive.)"""
+    n = 720
+    angles = 2 * math.pi * np.arange(n) / n
+    up = (angles > 0.05) & (angles < math.pi - 0.05)
+    t = np.arange(0.0, 4.0, 2e-4)
+    x = np.cos(angles[up])[:, None] * t
+    y = np.sin(angles[up])[:, None] * t
+    wall = 1.0 + 0.05 * (np.floor(x / 0.1) % 2)
+    first = np.argmax(y >= wall, axis=1)   # the first sample on or beyond the wall
+    ranges = np.full(n, np.nan)
+    ranges[up] = np.where(first > 0, t[first], np.nan)
+    scan = Scan(ranges, 0.0, 2 * math.pi / n, 0.1, 3.5, 0.0)
+    grazing = up & (np.abs(np.sin(angles)) < math.cos(math.radians(45))) & (ranges < 3.5)
+    assert np.count_nonzero(grazing) > 100
+    moved = {bound: np.mean(np.abs(denoise(scan, 0.015, 0.025, grazing=bound).ranges
+                                   - ranges)[grazing])
+             for bound in (GRAZING_OBSTACLES, GRAZING_MEMORY)}
+    assert moved[GRAZING_OBSTACLES] > 0.01 and moved[GRAZING_MEMORY] < 0.005

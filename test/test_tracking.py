@@ -54,6 +54,26 @@ def test_constant_velocity_target_is_estimated_within_3_cm_per_s():
     assert tracks.moving_points.all()
 
 
+@pytest.mark.parametrize('late', [0.0, 0.15])
+def test_a_cluster_seen_late_in_the_sweep_is_placed_at_the_scan_s_time(late):
+    """A walker at 1 m/s whose beams a spinning lidar takes ``late`` [s] after the
+    scan's first (its stamp): told when, the tracker keeps it where it was at the stamp
+    (within 3 cm), at its speed (within 0.1 m/s after 2 s); dated at the stamp, it is
+    placed ``late`` x 1 m/s ahead of where it was."""
+    v = np.array([0.0, 1.0])
+    start = np.array([2.0, -2.0])
+    told, untold = Tracker(0.15, 1.2, 0.6, 0.04), Tracker(0.15, 1.2, 0.6, 0.04)
+    for k in range(11):
+        t = 0.2 * k
+        pts = disc_points(start + v * (t + late), 0.2)
+        a = told.update(pts, t, np.zeros(len(pts)), after=np.full(len(pts), late))
+        b = untold.update(pts, t, np.zeros(len(pts)))
+    truth = disc_points(start + v * t, 0.2).mean(axis=0)   # the outline's centroid
+    assert np.hypot(*(a.position[0] - truth)) < 0.03
+    assert np.hypot(*(a.velocity[0] - v)) < 0.1
+    assert np.hypot(*(b.position[0] - truth)) == pytest.approx(late, abs=0.03)
+
+
 def test_a_standing_object_and_a_wall_do_not_move():
     tr = Tracker(0.15, 1.2, 0.6, 0.04)
     rng = np.random.default_rng(1)

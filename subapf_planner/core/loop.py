@@ -31,7 +31,7 @@ from .occupancy import OccupancyGrid
 from .params import check_fields, param
 from .planner import Planner
 from .robot import compose, invert
-from .scan import Scan, denoise, deskew
+from .scan import GRAZING_MEMORY, Scan, denoise, deskew
 from .status import State, Status
 from .supervisors import SUPERVISORS, Recoveries
 
@@ -111,7 +111,8 @@ class DecisionLoop:
         self.state = State.IDLE
         self.reason = 'no goal'
         self.supervisors = tuple(cls() for cls in SUPERVISORS)
-        self._deskew: tuple[Scan, Scan] | None = None   # the last scan, and deskewed
+        #: The last scan, and as the planner takes it (_deskewed)
+        self._deskew: tuple[Scan, Scan, Scan] | None = None
         self.recoveries = Recoveries()
 
     @property
@@ -250,22 +251,25 @@ class DecisionLoop:
         """base_footprint's motion (x, y, yaw) from the scan's first beam to its last, in
         its pose at the first, as odometry says (zero for a scan taken at once)."""
         n = np.size(scan.ranges)
-        if scan.time_increment <= 0.0 or n < 2 or not math.isfinite(scan.stamp):
+        if scan.beam_interval <= 0.0 or n < 2 or not math.isfinite(scan.stamp):
             return np.zeros(3)
         start = self.pose_between(scan.stamp)
-        end = self.pose_between(scan.stamp + (n - 1) * scan.time_increment)
+        end = self.pose_between(scan.stamp + (n - 1) * scan.beam_interval)
         return np.asarray(compose(invert(start), end))
 
-    def _deskewed(self, scan: Scan) -> Scan:
+    def _deskewed(self, scan: Scan) -> tuple[Scan, Scan]:
         """The scan as if taken at its first beam's instant (core/scan.py deskew), its
         ranges' noise averaged along each surface (core/scan.py denoise, by the lidar's
-        range_noise_*), once per scan."""
+        range_noise_*): for the obstacles and the tracker, and for the memory and the
+        alignment, where returns at grazing incidence keep their ranges
+        (GRAZING_MEMORY); once per scan."""
         if self._deskew is None or self._deskew[0] is not scan:
             cfg = self.cfg
             straight = deskew(scan, self.sweep_motion(scan), cfg.laser_mount)
-            self._deskew = (scan, denoise(straight, cfg.range_noise_floor,
-                                          cfg.range_noise_fraction))
-        return self._deskew[1]
+            noise = (cfg.range_noise_floor, cfg.range_noise_fraction)
+            self._deskew = (scan, denoise(straight, *noise),
+                            denoise(straight, *noise, grazing=GRAZING_MEMORY))
+        return self._deskew[1], self._deskew[2]
 
     def silent(self, now: float) -> tuple[bool, bool]:
         """Whether the scan, and the odometry, are silent at ``now`` [s]: none taken
@@ -300,9 +304,10 @@ class DecisionLoop:
             decision = s.before(self, now)
             if decision is not None:
                 return decision
-        result = self.planner.step(self.pose, self.goal, self._deskewed(self.scan),
-                                   self.pose_at(self.scan.stamp), now=now,
-                                   goal_in_map=self.goal_in_map)
+        scan, for_memory = self._deskewed(self.scan)
+        result = self.planner.step(self.pose, self.goal, scan, self.pose_at(self.scan.stamp),
+                                   now=now, goal_in_map=self.goal_in_map,
+                                   memory_scan=for_memory)
         for s in self.supervisors:
             decision = s.after(self, result, now)
             if decision is not None:

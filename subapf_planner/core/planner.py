@@ -186,7 +186,7 @@ class Planner:
 
     def step(self, pose: ArrayLike, goal: ArrayLike, scan: Scan,
              scan_pose: ArrayLike | None = None, *, now: float,
-             goal_in_map: bool = False) -> PlanResult:
+             goal_in_map: bool = False, memory_scan: Scan | None = None) -> PlanResult:
         """One cycle (module docstring) at time ``now`` [s] for the robot at ``pose``
         (x, y, yaw) in odom driving to ``goal`` (x, y) in odom (with ``goal_in_map``: in
         the memory's frame). The result's points, field and ``pose`` are in the memory's
@@ -196,7 +196,9 @@ class Planner:
         ``scan_pose``: base_footprint's odom pose when the scan was taken (default
         ``pose``); a robot that moved since is planned for from ``pose``. ``now`` paces
         the navigation field (field_period; -inf: a new field whenever the map
-        changed).
+        changed). ``memory_scan``: the same sweep as the memory and the scan alignment
+        take it (DecisionLoop._deskewed: not denoised at grazing incidence; default
+        ``scan``).
         """
         cfg = self.cfg
         pose = np.asarray(pose, float).ravel()
@@ -216,7 +218,13 @@ class Planner:
         points = to_parent(scan_pose, base)   # the returns in base_footprint, then placed
         tracks, transient = self._track(scan, points, scan_pose, now)
         if cfg.geodesic:   # the memory takes the scan in once the command is out
-            self._perception = Perception(scan, base, odom_scan_pose, goal, transient,
+            seen, seen_base = scan, base
+            if memory_scan is not None and memory_scan is not scan \
+                    and np.size(memory_scan.ranges) == np.size(scan.ranges):
+                seen = memory_scan   # (transient: per beam, the same beams)
+                seen_base = scan_to_points(seen, (0.0, 0.0, 0.0), cfg.laser_mount,
+                                           cfg.obstacle_range)
+            self._perception = Perception(seen, seen_base, odom_scan_pose, goal, transient,
                                           tracks.trail)
         cycle = Cycle(cfg, now, cfg.period, pose, goal, points, tracks=tracks,
                       previous=self.previous,
@@ -329,11 +337,13 @@ class Planner:
         origin = compose(scan_pose, self.cfg.laser_mount)[:2]
         noise = range_sigma(np.hypot(*(points - origin).T), self.cfg.range_noise_floor,
                             self.cfg.range_noise_fraction)
+        beams = np.flatnonzero(scan.valid(self.cfg.obstacle_range))   # those of points
         tracks = self.tracker.update(points, t, self.memory.log_odds_at(points),
                                      self.memory.standing(points, origin, 2.0 * noise,
-                                                          STANDING_SCANS))
+                                                          STANDING_SCANS),
+                                     beams * scan.beam_interval)
         transient = np.zeros(np.size(scan.ranges), bool)
-        transient[np.flatnonzero(scan.valid(self.cfg.obstacle_range))] = tracks.held_points
+        transient[beams] = tracks.held_points
         return tracks, transient
 
     def _stop(self, result: PlanResult) -> PlanResult:

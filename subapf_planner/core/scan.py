@@ -20,6 +20,11 @@ class ScanError(ValueError):
     """The scan's geometry is unusable (e.g. angle_increment not positive)."""
 
 
+#: The longest sweep a scan's time_increment may describe [s] (Scan.beam_interval):
+#: lidars sweep at 5-40 Hz.
+MAX_SWEEP = 1.0
+
+
 @dataclass(frozen=True, eq=False)
 class Scan:
     """One 2-D laser sweep in the laser's frame (``base_scan``), as every layer passes it:
@@ -50,6 +55,16 @@ class Scan:
             raise ScanError(f'non-finite scan geometry {geometry}')
         if np.size(self.ranges) > 1 and self.angle_increment <= 0.0:
             raise ScanError(f'angle_increment must be positive, got {self.angle_increment}')
+
+    @property
+    def beam_interval(self) -> float:
+        """``time_increment`` [s] when it describes a sweep (finite, positive, the whole
+        sweep within MAX_SWEEP), else 0: taken at once. A driver's NaN or a sweep of
+        minutes must not bend the scan nor date its beams."""
+        inc = self.time_increment
+        ok = math.isfinite(inc) and inc > 0.0 \
+            and inc * max(np.size(self.ranges) - 1, 0) <= MAX_SWEEP
+        return float(inc) if ok else 0.0
 
     @property
     def angles(self) -> NDArray[np.float64]:
@@ -105,10 +120,12 @@ def deskew(scan: Scan, motion: ArrayLike, mount: ArrayLike = (0.0, 0.0, 0.0)) ->
     the bin of its direction from the laser at the first beam (the nearest return when
     several land in one; a bin none lands in has no return, NaN: it clears no cell).
     A scan taken all at once (time_increment 0), or with no motion, is returned as it
-    is. Beams with no return keep it."""
+    is. Beams with no return keep it. The beams keep their instants (time_increment):
+    what moved during the sweep is where it was when its beam saw it (the tracker
+    dates its clusters by them); so a scan is de-skewed once (DecisionLoop._deskewed)."""
     n = np.size(scan.ranges)
     motion = np.asarray(motion, float)
-    if n < 2 or scan.time_increment <= 0.0 or not np.all(np.isfinite(motion)) \
+    if n < 2 or scan.beam_interval <= 0.0 or not np.all(np.isfinite(motion)) \
             or not np.any(motion):
         return scan
     scan.check()
@@ -137,7 +154,7 @@ def deskew(scan: Scan, motion: ArrayLike, mount: ArrayLike = (0.0, 0.0, 0.0)) ->
     order = np.argsort(-dist)   # nearest written last: it wins its bin
     out[bins[order]] = dist[order]
     return Scan(out, scan.angle_min, scan.angle_increment, scan.range_min, scan.range_max,
-                scan.stamp, 0.0, scan.scan_time)
+                scan.stamp, scan.time_increment, scan.scan_time)
 
 
 def range_sigma(ranges: ArrayLike, floor: float, fraction: float) -> NDArray[np.float64]:
@@ -146,7 +163,23 @@ def range_sigma(ranges: ArrayLike, floor: float, fraction: float) -> NDArray[np.
     return np.maximum(floor, fraction * np.asarray(ranges, float))
 
 
-def denoise(scan: Scan, floor: float, fraction: float, half_window: int = 3) -> Scan:
+#: The most oblique incidence at which denoise moves a return onto its line: the cosine
+#: of the angle between the ray and the line's normal. For the obstacles and the tracker
+#: (a cluster's centroid steady) ...
+GRAZING_OBSTACLES = 0.3
+#: ... and for the memory and the scan alignment (DecisionLoop.perceived). Across
+#: seven beams at a grazing incidence a line spans a long stretch of surface; where the
+#: surface is not straight at that length (jambs, shelves, a wall's steps) the return
+#: moves along its ray by several times the line's misfit, and on the same stretch by
+#: as much each time the robot passes at that angle: with exact rays along a corridor of
+#: stepped walls, perfect odometry and the obstacles' bound, the memory's walls were
+#: drawn so that the alignment took the robot to have driven 1 % farther than it had
+#: (test/test_alignment.py::test_stepped_walls_do_not_stretch_the_drive).
+GRAZING_MEMORY = 0.7
+
+
+def denoise(scan: Scan, floor: float, fraction: float, half_window: int = 3,
+            grazing: float = GRAZING_OBSTACLES) -> Scan:
     """The scan with each return moved along its ray onto the line through it and its
     neighbours on the same surface: up to ``half_window`` beams on either side, valid, no
     farther in range than four of the lidar's standard deviations (``floor`` [m], or
@@ -157,8 +190,8 @@ def denoise(scan: Scan, floor: float, fraction: float, half_window: int = 3) -> 
     them are as thin as the map's cells. A line, unlike a mean of ranges, leaves a wall
     seen at a slant where it is. A return with fewer than two neighbours (a depth edge,
     a lone return such as a mixed pixel), one whose line its ray meets at a grazing
-    angle, and a beam with no return are left as they are. Without noise (both 0) the
-    scan is returned as it is."""
+    angle (the cosine of the incidence below ``grazing``), and a beam with no return are
+    left as they are. Without noise (both 0) the scan is returned as it is."""
     n = np.size(scan.ranges)
     if n < 3 or half_window < 1 or (floor <= 0.0 and fraction <= 0.0) \
             or not math.isfinite(scan.angle_min) or not math.isfinite(scan.angle_increment):
@@ -192,7 +225,7 @@ def denoise(scan: Scan, floor: float, fraction: float, half_window: int = 3) -> 
     along = 0.5 * np.arctan2(2.0 * cxy, cxx - cyy)   # the line's direction
     nx, ny = -np.sin(along), np.cos(along)          # its normal
     meet = nx * ux + ny * uy
-    ok = hit & (count >= 3.0) & (np.abs(meet) >= 0.3)
+    ok = hit & (count >= 3.0) & (np.abs(meet) >= grazing)
     with np.errstate(divide='ignore', invalid='ignore'):
         on_line = (nx * mx + ny * my) / meet
     ok &= np.isfinite(on_line) & (np.abs(on_line - rr) <= 4.0 * sigma)

@@ -234,21 +234,32 @@ class Tracker:
         self.x = self.x @ f.T
         self.P = f @ self.P @ f.T + noise
 
-    def _correct(self, rows: NDArray[np.int64], z: NDArray[np.float64]) -> None:
+    def _correct(self, rows: NDArray[np.int64], z: NDArray[np.float64],
+                 lag: NDArray[np.float64]) -> None:
+        """Kalman update of tracks ``rows`` by centroids ``z`` (k, 2) [m] measured
+        ``lag`` (k,) [s] after the tracks' time (the sweep took them then): the
+        measurement is the position plus lag times the velocity."""
         cov = self.P[rows]
-        s = cov[:, :2, :2] + MEASUREMENT_SIGMA ** 2 * np.eye(2)
-        gain = cov[:, :, :2] @ np.linalg.inv(s)
-        innovation = z - self.x[rows, :2]
+        h = np.zeros((len(rows), 2, 4))
+        h[:, 0, 0] = h[:, 1, 1] = 1.0
+        h[:, 0, 2] = h[:, 1, 3] = lag
+        ph = cov @ h.transpose(0, 2, 1)
+        s = h @ ph + MEASUREMENT_SIGMA ** 2 * np.eye(2)
+        gain = ph @ np.linalg.inv(s)
+        innovation = z - np.einsum('nij,nj->ni', h, self.x[rows])
         self.x[rows] += np.einsum('nij,nj->ni', gain, innovation)
-        self.P[rows] = cov - gain @ cov[:, :2, :]
+        self.P[rows] = cov - gain @ h @ cov
 
     def update(self, points: NDArray[np.float64], t: float,
                log_odds_at: NDArray[np.float64],
-               standing: NDArray[np.bool_] | None = None) -> Tracks:
+               standing: NDArray[np.bool_] | None = None,
+               after: NDArray[np.float64] | None = None) -> Tracks:
         """Take a scan's obstacle points (n, 2) at time ``t`` [s] with the memory's log
-        odds at each (n,; 0 off the map) and whether each is on an obstacle that has stood
-        STANDING_SCANS scans (n,; none when not given), before the scan is written;
-        returns the tracks.
+        odds at each (n,; 0 off the map), whether each is on an obstacle that has stood
+        STANDING_SCANS scans (n,; none when not given) and how long after ``t`` each was
+        taken (n, [s]; a spinning lidar's beam i is i * time_increment after the first:
+        a walker seen late in the sweep is measured where it was then; none: all at
+        ``t``), before the scan is written; returns the tracks, at time ``t``.
         A scan at the same time as the last is not taken again (the tracks stand)."""
         if self.time is not None and t == self.time and self._last is not None:
             return self._last   # the same scan again (a tick without a new one)
@@ -261,6 +272,8 @@ class Tracker:
             self._predict(dt)
         labels, count = clusters(points, self.gap)
         cents, sizes, new, mapped, thin = _cluster_features(points, labels, count, log_odds_at)
+        lag = np.zeros(count) if after is None or not count else \
+            np.bincount(labels, after, count) / np.bincount(labels, minlength=count)
         held_up = np.zeros(count, bool) if standing is None or not count else \
             np.bincount(labels, standing, count) / np.bincount(labels, minlength=count) \
             >= HELD_UP_FRACTION
@@ -274,11 +287,13 @@ class Tracker:
         track_of = np.full(count, -1, np.int64)
         n_tracks = len(self.x)
         if n_tracks and small.size:
-            cost = np.hypot(*(self.x[:, None, :2] - cents[None, small]).transpose(2, 0, 1))
+            # each track where it was when the sweep saw each cluster
+            at = self.x[:, None, :2] + lag[None, small, None] * self.x[:, None, 2:]
+            cost = np.hypot(*(at - cents[None, small]).transpose(2, 0, 1))
             rows, cols = linear_sum_assignment(np.where(cost <= self.gate, cost, 1e6))
             ok = cost[rows, cols] <= self.gate
             rows, cols = rows[ok], cols[ok]
-            self._correct(rows, cents[small[cols]])
+            self._correct(rows, cents[small[cols]], lag[small[cols]])
             track_of[small[cols]] = rows
         seen = np.zeros(n_tracks, bool)
         seen[track_of[track_of >= 0]] = True

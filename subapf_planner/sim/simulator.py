@@ -37,7 +37,7 @@ import pybullet
 from pybullet_utils.bullet_client import BulletClient
 
 from ..core.params import ConfigError, check_fields, param
-from ..core.robot import BURGER, compose
+from ..core.robot import BURGER
 from ..core.scan import Scan
 from .sensor import LIDARS, Lidar, corrupt
 from .world import Box, Circle, World
@@ -155,6 +155,9 @@ class BurgerSim:
         self._sweep_cast = 0
         self._sweep_true = np.full(n, np.inf)
         self._swept: list[Scan] = []
+        #: The time and true pose of the last physics step (beams are cast from the pose
+        #: between it and the next one at their own instants).
+        self._stepped_from = (self.time, self.true_pose())
         self._advance_sweep()
 
     def _build(self) -> None:
@@ -332,15 +335,19 @@ class BurgerSim:
         pose = self.true_pose() if self._odom is None else self._odom.copy()
         return pose, self.true_velocity()
 
-    def _cast(self, beams: slice) -> np.ndarray:
-        """True ranges [m] (+inf: no return) of ``beams`` of a sweep, cast now from where
-        the laser is."""
+    def _cast(self, beams: slice, poses: np.ndarray | None = None) -> np.ndarray:
+        """True ranges [m] (+inf: no return) of ``beams`` of a sweep, cast from where the
+        laser is now, or with base_footprint at ``poses`` (one (x, y, yaw) per beam)."""
         cfg = self.config
-        pose = self.true_pose()
-        ox, oy, _ = compose(pose, ROBOT.laser.planar)
-        a = self._angles[beams] + pose[2]
+        a = self._angles[beams]
         n = a.size
-        origin = np.tile([ox, oy, ROBOT.laser.z], (n, 1))
+        if poses is None:
+            poses = np.tile(self.true_pose(), (n, 1))
+        mx, my, myaw = ROBOT.laser.planar
+        c, s = np.cos(poses[:, 2]), np.sin(poses[:, 2])
+        origin = np.column_stack((poses[:, 0] + c * mx - s * my, poses[:, 1] + s * mx + c * my,
+                                  np.full(n, ROBOT.laser.z)))
+        a = a + poses[:, 2] + myaw
         ends = origin + cfg.range_max * np.column_stack((np.cos(a), np.sin(a), np.zeros(n)))
         hits = pybullet.rayTestBatch(origin.tolist(), ends.tolist(),
                                      numThreads=cfg.scan_threads, physicsClientId=self._cid)
@@ -370,9 +377,21 @@ class BurgerSim:
         if tau < -1e-9:
             return
         due = n if inc == 0.0 else min(n, int(math.floor(tau / inc + 1e-6)) + 1)
+        t1, p1 = self.time, self.true_pose()
         if due > self._sweep_cast:
-            self._sweep_true[self._sweep_cast:due] = self._cast(slice(self._sweep_cast, due))
+            # each beam from where the laser was at its instant, between the last physics
+            # step and this one (a beam is due up to a step after its instant)
+            t0, p0 = self._stepped_from
+            instants = self._sweep_t0 + inc * np.arange(self._sweep_cast, due)
+            f = np.clip((instants - t0) / (t1 - t0), 0.0, 1.0) if t1 > t0 \
+                else np.ones(instants.size)
+            turn = math.remainder(p1[2] - p0[2], 2.0 * math.pi)
+            poses = np.column_stack((p0[0] + f * (p1[0] - p0[0]), p0[1] + f * (p1[1] - p0[1]),
+                                     p0[2] + f * turn))
+            self._sweep_true[self._sweep_cast:due] = self._cast(slice(self._sweep_cast, due),
+                                                                poses)
             self._sweep_cast = due
+        self._stepped_from = (t1, p1)
         if due < n:
             return
         self._swept.append(Scan(self._reported(self._sweep_true), 0.0, 2.0 * math.pi / n,
