@@ -111,7 +111,7 @@ class DecisionLoop:
         self.state = State.IDLE
         self.reason = 'no goal'
         self.supervisors = tuple(cls() for cls in SUPERVISORS)
-        #: The last scan, and as the planner takes it (_deskewed)
+        #: The last scan, and as the obstacles and as the memory take it (_deskewed)
         self._deskew: tuple[Scan, Scan, Scan] | None = None
         self.recoveries = Recoveries()
 

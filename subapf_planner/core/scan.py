@@ -167,7 +167,7 @@ def range_sigma(ranges: ArrayLike, floor: float, fraction: float) -> NDArray[np.
 #: of the angle between the ray and the line's normal. For the obstacles and the tracker
 #: (a cluster's centroid steady) ...
 GRAZING_OBSTACLES = 0.3
-#: ... and for the memory and the scan alignment (DecisionLoop.perceived). Across
+#: ... and for the memory and the scan alignment (DecisionLoop._deskewed). Across
 #: seven beams at a grazing incidence a line spans a long stretch of surface; where the
 #: surface is not straight at that length (jambs, shelves, a wall's steps) the return
 #: moves along its ray by several times the line's misfit, and on the same stretch by
