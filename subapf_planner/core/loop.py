@@ -31,7 +31,7 @@ from .occupancy import OccupancyGrid
 from .params import check_fields, param
 from .planner import Planner
 from .robot import compose, invert
-from .scan import GRAZING_MEMORY, Scan, denoise, deskew
+from .scan import GRAZING_MEMORY, GRAZING_OBSTACLES, Scan, denoise_each, deskew
 from .status import State, Status
 from .supervisors import SUPERVISORS, Recoveries
 
@@ -266,9 +266,9 @@ class DecisionLoop:
         if self._deskew is None or self._deskew[0] is not scan:
             cfg = self.cfg
             straight = deskew(scan, self.sweep_motion(scan), cfg.laser_mount)
-            noise = (cfg.range_noise_floor, cfg.range_noise_fraction)
-            self._deskew = (scan, denoise(straight, *noise),
-                            denoise(straight, *noise, grazing=GRAZING_MEMORY))
+            self._deskew = (scan, *denoise_each(straight, cfg.range_noise_floor,
+                                                cfg.range_noise_fraction,
+                                                (GRAZING_OBSTACLES, GRAZING_MEMORY)))
         return self._deskew[1], self._deskew[2]
 
     def silent(self, now: float) -> tuple[bool, bool]:

@@ -7,6 +7,7 @@ values below ``range_min`` and values at or beyond ``range_max`` (no return).
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 import math
 
@@ -180,6 +181,12 @@ GRAZING_MEMORY = 0.7
 
 def denoise(scan: Scan, floor: float, fraction: float, half_window: int = 3,
             grazing: float = GRAZING_OBSTACLES) -> Scan:
+    """The scan smoothed along its surfaces (:func:`denoise_each` with one bound)."""
+    return denoise_each(scan, floor, fraction, (grazing,), half_window)[0]
+
+
+def denoise_each(scan: Scan, floor: float, fraction: float, grazing: Sequence[float],
+                 half_window: int = 3) -> tuple[Scan, ...]:
     """The scan with each return moved along its ray onto the line through it and its
     neighbours on the same surface: up to ``half_window`` beams on either side, valid, no
     farther in range than four of the lidar's standard deviations (``floor`` [m], or
@@ -190,12 +197,13 @@ def denoise(scan: Scan, floor: float, fraction: float, half_window: int = 3,
     them are as thin as the map's cells. A line, unlike a mean of ranges, leaves a wall
     seen at a slant where it is. A return with fewer than two neighbours (a depth edge,
     a lone return such as a mixed pixel), one whose line its ray meets at a grazing
-    angle (the cosine of the incidence below ``grazing``), and a beam with no return are
-    left as they are. Without noise (both 0) the scan is returned as it is."""
+    angle (the cosine of the incidence below the bound), and a beam with no return are
+    left as they are: one scan per bound of ``grazing``, the lines fitted once. Without
+    noise (both 0) the scan is returned as it is."""
     n = np.size(scan.ranges)
     if n < 3 or half_window < 1 or (floor <= 0.0 and fraction <= 0.0) \
             or not math.isfinite(scan.angle_min) or not math.isfinite(scan.angle_increment):
-        return scan   # (a scan with no geometry is refused by the planner)
+        return (scan,) * len(grazing)   # (a scan with no geometry is refused by the planner)
     r = np.asarray(scan.ranges, float).ravel()
     hit = scan.valid()
     rr = np.where(hit, r, 0.0)
@@ -225,13 +233,12 @@ def denoise(scan: Scan, floor: float, fraction: float, half_window: int = 3,
     along = 0.5 * np.arctan2(2.0 * cxy, cxx - cyy)   # the line's direction
     nx, ny = -np.sin(along), np.cos(along)          # its normal
     meet = nx * ux + ny * uy
-    ok = hit & (count >= 3.0) & (np.abs(meet) >= grazing)
     with np.errstate(divide='ignore', invalid='ignore'):
         on_line = (nx * mx + ny * my) / meet
-    ok &= np.isfinite(on_line) & (np.abs(on_line - rr) <= 4.0 * sigma)
-    out = np.where(ok, on_line, r)
-    return Scan(out, scan.angle_min, scan.angle_increment, scan.range_min, scan.range_max,
-                scan.stamp, scan.time_increment, scan.scan_time)
+    ok = hit & (count >= 3.0) & np.isfinite(on_line) & (np.abs(on_line - rr) <= 4.0 * sigma)
+    return tuple(Scan(np.where(ok & (np.abs(meet) >= bound), on_line, r), scan.angle_min,
+                      scan.angle_increment, scan.range_min, scan.range_max, scan.stamp,
+                      scan.time_increment, scan.scan_time) for bound in grazing)
 
 
 def geometry_warning(n: int, angle_min: float, angle_max: float,

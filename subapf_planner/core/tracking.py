@@ -272,11 +272,11 @@ class Tracker:
             self._predict(dt)
         labels, count = clusters(points, self.gap)
         cents, sizes, new, mapped, thin = _cluster_features(points, labels, count, log_odds_at)
+        members = np.bincount(labels, minlength=count)
         lag = np.zeros(count) if after is None or not count else \
-            np.bincount(labels, after, count) / np.bincount(labels, minlength=count)
+            np.bincount(labels, after, count) / members
         held_up = np.zeros(count, bool) if standing is None or not count else \
-            np.bincount(labels, standing, count) / np.bincount(labels, minlength=count) \
-            >= HELD_UP_FRACTION
+            np.bincount(labels, standing, count) / members >= HELD_UP_FRACTION
         # walls are not tracked: long clusters (but up to NEW_SIZE_FACTOR times as long
         # where the memory saw free space: people side by side, or one close enough to
         # show their whole width), straight ones, those on the map's established obstacles
