@@ -242,7 +242,7 @@ class DecisionLoop:
                 f = 0.0 if t1 <= t0 else (stamp - t0) / (t1 - t0)
                 dyaw = math.remainder(p1[2] - p0[2], 2 * math.pi)
                 return np.array([p0[0] + f * (p1[0] - p0[0]), p0[1] + f * (p1[1] - p0[1]),
-                                 p0[2] + f * dyaw])
+                                 math.remainder(p0[2] + f * dyaw, 2 * math.pi)])
             if t1 < stamp:
                 break
         return poses[-1][1]

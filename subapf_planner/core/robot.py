@@ -138,11 +138,12 @@ ROBOTS = {'burger': BURGER, 'waffle_pi': WAFFLE_PI, 'turtlebot4': TURTLEBOT4}
 def compose(parent: ArrayLike, child: ArrayLike) -> tuple[float, float, float]:
     """The pose ``child`` (x, y, yaw), given in the frame whose pose is ``parent``,
     expressed in parent's frame: e.g. base_scan in odom from base_footprint in odom and
-    the mounting."""
+    the mounting. The yaw in [-pi, pi] [rad]: a motion between two poses either side of
+    +-pi is the small turn between them, not a turn and a whole one."""
     x, y, yaw = (float(v) for v in parent)
     cx, cy, cyaw = (float(v) for v in child)
     c, s = math.cos(yaw), math.sin(yaw)
-    return (x + c * cx - s * cy, y + s * cx + c * cy, yaw + cyaw)
+    return (x + c * cx - s * cy, y + s * cx + c * cy, math.remainder(yaw + cyaw, 2 * math.pi))
 
 
 def invert(pose: ArrayLike) -> tuple[float, float, float]:

@@ -125,7 +125,9 @@ def deskew(scan: Scan, motion: ArrayLike, mount: ArrayLike = (0.0, 0.0, 0.0)) ->
     what moved during the sweep is where it was when its beam saw it (the tracker
     dates its clusters by them); so a scan is de-skewed once (DecisionLoop._deskewed)."""
     n = np.size(scan.ranges)
-    motion = np.asarray(motion, float)
+    motion = np.array(motion, float).ravel()
+    if motion.size == 3 and math.isfinite(motion[2]):   # a sweep turns less than a turn
+        motion[2] = math.remainder(motion[2], 2 * math.pi)
     if n < 2 or scan.beam_interval <= 0.0 or not np.all(np.isfinite(motion)) \
             or not np.any(motion):
         return scan
