@@ -16,7 +16,8 @@ pytestmark = pytest.mark.sim
 #: The paper's method exactly: Euclidean attraction (eq. 21), samples discarded within d0.
 PAPER = PlannerConfig(attraction_field='euclidean')
 KEYS = {'world', 'method', 'outcome', 'time_s', 'path_length', 'min_clearance',
-        'mean_abs_curvature', 'plan_ms_median', 'plan_ms_p99', 'cycles'}
+        'mean_abs_curvature', 'plan_ms_median', 'plan_ms_p99', 'cycles', 'shortest_path',
+        'time_over_limit', 'path_over_shortest'}
 
 
 def test_short_bench_writes_consistent_results(tmp_path, worlds_dir):
@@ -43,6 +44,10 @@ def test_short_bench_writes_consistent_results(tmp_path, worlds_dir):
         sweeps = r['time_s'] / PAPER.period
         assert 0.95 * sweeps - 1 <= r['cycles'] <= sweeps + 1
         assert r['cycles'] >= 1 and r['plan_ms_p99'] >= r['plan_ms_median'] > 0
+        # no faster than the shortest path at top speed (the grid's geodesic is up to
+        # 8 % long), and that path no longer than the straight line plus a detour
+        assert straight - 0.05 <= r['shortest_path'] <= 1.3 * straight
+        assert r['time_over_limit'] >= 0.9 and r['path_over_shortest'] >= 0.9
     assert (out / 'summary.md').read_text().startswith('| method |')
     assert (out / 'four_points.png').stat().st_size > 10_000
 

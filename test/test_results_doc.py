@@ -2,6 +2,7 @@
 the README's headline block, --check; and subapf-bench's record of how it ran."""
 
 import json
+import math
 from pathlib import Path
 import re
 import shlex
@@ -238,3 +239,43 @@ def test_the_pose_error_and_the_ghosts_are_reported_where_recorded():
     assert '| 80 % |' in rows[0] and '1.00 % (most 3)' in rows[0]   # 4 of 5; 4 in 400
     plain = results.load_runset_doc(bench_doc(RUNS), 'y.json')
     assert results.perception_table(plain) == ''
+
+
+@core
+def test_time_and_path_against_the_shortest_are_reported_where_recorded():
+    """The speed table: per method, over its runs that reached, the time over the
+    physical limit and the path over the shortest path (median, p90); nothing for files
+    from before the bench recorded them."""
+    timed = [dict(r, time_over_limit=t, path_over_shortest=p)
+             for r, t, p in zip(RUNS[:3], (1.0, 1.2, 2.0), (1.0, 1.1, 1.5), strict=True)]
+    rs = results.load_runset_doc(bench_doc(timed + RUNS[3:]), 'x.json')
+    cells = row(results.speed_table(rs), 'a:geodesic')
+    assert cells[1:] == ['3', '1.20', '1.84', '1.10', '1.42']   # p90 interpolated
+    assert results.speed_table(results.load_runset_doc(bench_doc(RUNS), 'y.json')) == ''
+
+
+@core
+def test_the_shortest_path_comes_from_the_suites_index_or_the_geodesic(tmp_path):
+    """bench.shortest_path: a world with an entry in the index.json beside it (the
+    real-building tasks') takes its smoothed length; one without, the geodesic of
+    sim/solvability.py (round a wall: longer than the straight line); efficiency()
+    divides by it, for reached runs only."""
+    from subapf_planner.sim.world import load_world
+    from subapf_planner.tools.bench import efficiency, shortest_path
+    text = ('name: {}\nstart: [0.0, 0.0, 0.0]\ngoal: [4.0, 0.0]\nbounds: [-2, -3, 6, 3]\n'
+            'obstacles:\n- box: {{center: [2.0, 0.0], size: [0.2, 3.0]}}\n')
+    for name in ('listed', 'unlisted'):
+        (tmp_path / f'{name}.yaml').write_text(text.format(name))
+    (tmp_path / 'index.json').write_text(json.dumps(
+        {'hall': {'source': 'x', 'worlds': {'listed': {'smoothed': 7.25}}}}))
+    assert shortest_path(load_world(tmp_path / 'listed.yaml')) == 7.25
+    round_wall = shortest_path(load_world(tmp_path / 'unlisted.yaml'))
+    assert 5.0 < round_wall < 7.0          # 4 m straight, the wall is 3 m tall
+    record = {'outcome': 'reached', 'time_s': 40.0, 'path_length': 8.0}
+    e = efficiency(record, 7.25, 0.22)
+    assert e['shortest_path'] == 7.25
+    assert e['time_over_limit'] == pytest.approx(40.0 * 0.22 / 7.25, abs=1e-3)
+    assert e['path_over_shortest'] == pytest.approx(8.0 / 7.25, abs=1e-3)
+    missed = efficiency(dict(record, outcome='missed'), 7.25, 0.22)
+    assert missed['time_over_limit'] is None and missed['path_over_shortest'] is None
+    assert efficiency(record, math.inf, 0.22)['shortest_path'] is None

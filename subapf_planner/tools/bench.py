@@ -20,6 +20,7 @@ from concurrent.futures import Executor, ProcessPoolExecutor
 import contextlib
 import dataclasses
 import datetime
+import functools
 import importlib.metadata
 import json
 import math
@@ -39,6 +40,7 @@ from ..ros.paths import default_params_file, shipped_worlds_dir
 from ..sim.episode import run_episode
 from ..sim.faults import ScanFaults
 from ..sim.simulator import SimConfig
+from ..sim.solvability import geodesic_length
 from ..sim.world import World, WorldError, load_world, world_files
 from .animation import animate_run
 from .plots import plot_trajectories
@@ -54,6 +56,54 @@ FIELDS = ('geodesic', 'euclidean')
 FOUR_FAULTS = {'noise': 0.03, 'beam_dropout': 0.2, 'scan_dropout': 0.2, 'scan_latency': 0.1}
 #: How long --cluster waits for its scheduler [s].
 CLUSTER_CONNECT_TIMEOUT = 30.0
+#: A suite's shortest paths, beside its world files (``../shared/dev_maps/index.json``:
+#: per building, ``worlds`` by name, each with its ``smoothed`` shortest path [m]).
+INDEX = 'index.json'
+
+
+@functools.lru_cache(maxsize=8)
+def _index(path: Path) -> dict[str, float]:
+    """World name -> smoothed shortest path [m] from an INDEX file ({} when it is not
+    one)."""
+    try:
+        doc = json.loads(path.read_text())
+    except (OSError, ValueError):
+        return {}
+    found = {}
+    for entry in doc.values() if isinstance(doc, dict) else ():
+        worlds = entry.get('worlds') if isinstance(entry, dict) else None
+        for name, task in (worlds.items() if isinstance(worlds, dict) else ()):
+            length = task.get('smoothed') if isinstance(task, dict) else None
+            if isinstance(length, (int, float)) and math.isfinite(length) and length > 0:
+                found[name] = float(length)
+    return found
+
+
+def shortest_path(world: World) -> float:
+    """The world's shortest path from start to goal [m]: the smoothed length an INDEX
+    beside its file gives, else the geodesic of sim/solvability.py (8-connected cells of
+    5 cm, a disc of the burger's footprint plus margin: up to 8 % longer than the true
+    shortest path, so the ratios below come out up to that much low); inf when there is
+    no way."""
+    index = Path(world.source).parent / INDEX
+    if index.is_file():
+        length = _index(index).get(world.name)
+        if length is not None:
+            return length
+    return geodesic_length(world)
+
+
+def efficiency(record: dict, shortest: float, top_speed: float) -> dict:
+    """The run's record with its world's ``shortest_path`` [m] and, when it reached,
+    ``time_over_limit`` (its time over the physical limit: the shortest path at the
+    robot's top speed) and ``path_over_shortest`` (its path over the shortest); None
+    where they do not apply."""
+    known = math.isfinite(shortest) and shortest > 0.0 and top_speed > 0.0
+    ok = known and record['outcome'] == 'reached'
+    return {**record, 'shortest_path': round(shortest, 3) if known else None,
+            'time_over_limit': round(record['time_s'] * top_speed / shortest, 3)
+            if ok else None,
+            'path_over_shortest': round(record['path_length'] / shortest, 3) if ok else None}
 
 
 def parse_method(spec: str) -> dict:
@@ -73,11 +123,13 @@ def _run_world(job: tuple) -> list[tuple[dict, list]]:
     """All methods on one world (in a worker), and its plot when ``plot_dir`` is set."""
     world, methods, cfg, sim_cfg, faults, plot_dir, animate = job
     out = []
+    shortest = shortest_path(world)
     for spec in methods:
         run_cfg = cfg.replace(**parse_method(spec))
         label = f'{run_cfg.method}:{run_cfg.attraction_field}'
         result = run_episode(world, run_cfg, sim_cfg, faults=faults, label=label)
-        out.append((result.metrics(world), result.path[:, :2].round(4).tolist()))
+        out.append((efficiency(result.metrics(world), shortest, run_cfg.max_linear_velocity),
+                    result.path[:, :2].round(4).tolist()))
     if plot_dir is not None:
         _plot_world(world, out, Path(plot_dir), cfg.period, animate)
     return out
@@ -197,6 +249,25 @@ def perception(runs: list[dict], methods: list[str]) -> str:
             f'{max(worst, default=math.nan):.3f} | {sum(evading)} '
             f'({sum(evading) / max(cycles, 1):.2%}, {max(evading, default=0)}) |')
     return '\n'.join(lines) + '\n'
+
+
+def speed(runs: list[dict], methods: list[str]) -> str:
+    """Per method, over the runs that reached: time over the physical limit and path
+    over the shortest path (median, p90); '' when no run records them."""
+    lines = []
+    for m in methods:
+        ok = [r for r in runs if r['method'] == m and r.get('time_over_limit') is not None]
+        if not ok:
+            continue
+        t = [r['time_over_limit'] for r in ok]
+        p = [r['path_over_shortest'] for r in ok]
+        lines.append(f'| {m} | {len(ok)} | {_percentile(t, 50):.2f} / {_percentile(t, 90):.2f} '
+                     f'| {_percentile(p, 50):.2f} / {_percentile(p, 90):.2f} |')
+    if not lines:
+        return ''
+    return '\n'.join(['| method | reached | time over the physical limit, median / p90 '
+                      '| path over the shortest, median / p90 |', '|---|---|---|---|',
+                      *lines]) + '\n'
 
 
 def summarise(runs: list[dict], methods: list[str]) -> str:
@@ -380,6 +451,7 @@ def main(argv: list[str] | None = None) -> int:
     (out / 'results.json').write_text(json.dumps(doc, indent=1))
     (out / 'summary.md').write_text(summarise(runs, labels) + '\n' + by_family(runs, labels)
                                     + '\n' + perception(runs, labels)
+                                    + '\n' + speed(runs, labels)
                                     + '\n' + paired(runs, labels)
                                     + f'\n{len(runs)} runs in {wall:.1f} s wall time.\n')
     print((out / 'summary.md').read_text())

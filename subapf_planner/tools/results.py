@@ -80,7 +80,12 @@ for `unreachable_timeout`), *timeout* (the world's time limit). Columns: success
 reached / runs; times and path lengths are over the reached runs (p90: 90th
 percentile); least clearance is the smallest gap between the robot's footprint and an
 obstacle's surface over all runs (negative: a collision); "stopped" counts collisions
-with the robot commanded to stand still.
+with the robot commanded to stand still. Time over the physical limit: a run's time
+over its world's shortest path at the robot's top speed; path over the shortest: its
+path length over that path (both over the reached runs; the shortest path is the
+smoothed one of the suite's `index.json` where there is one, as for the real-building
+tasks, else the 5 cm grid's geodesic for a disc of the burger's footprint plus margin,
+up to 8 % longer than the true one).
 
 To add or refresh a suite: run the bench, copy its `results.json` to
 `docs/results/data/<suite>.json` (name and text in `suites.yaml` there), then
@@ -227,6 +232,25 @@ def perception_table(rs: RunSet) -> str:
                       *lines])
 
 
+def speed_table(rs: RunSet) -> str:
+    """Per method, over its runs that reached: time over the physical limit (the shortest
+    path at the robot's top speed) and path over the shortest path, median and p90; ''
+    when no run records them (results files from before the bench did)."""
+    lines = []
+    for m in rs.methods:
+        ok = [r for r in rs.runs if r['method'] == m and r.get('time_over_limit') is not None]
+        if not ok:
+            continue
+        t = [r['time_over_limit'] for r in ok]
+        p = [r['path_over_shortest'] for r in ok]
+        lines.append(f'| `{m}` | {len(ok)} | {_num(_median(t), 2)} | {_num(_p90(t), 2)} '
+                     f'| {_num(_median(p), 2)} | {_num(_p90(p), 2)} |')
+    if not lines:
+        return ''
+    return '\n'.join(['| method | reached | time over the physical limit, median | p90 '
+                      '| path over the shortest, median | p90 |', '|' + '---|' * 6, *lines])
+
+
 def worlds_table(rs: RunSet) -> str:
     """Outcome per world and method (small suites), or reached per family (generated
     suites of several families); '' otherwise."""
@@ -331,9 +355,9 @@ def render_page(suites: list[Suite], methods: list[tuple[str, str]]) -> str:
                 parts.append(f'### {rs.name}\n')
             parts.append(methods_table(rs) + '\n')
             parts.append(provenance(rs) + '\n')
-            seen = perception_table(rs)
-            if seen:
-                parts.append(seen + '\n')
+            for extra in (perception_table(rs), speed_table(rs)):
+                if extra:
+                    parts.append(extra + '\n')
             extra = worlds_table(rs)
             if extra:
                 parts.append(extra + '\n')
