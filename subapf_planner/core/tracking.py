@@ -8,7 +8,8 @@ cells the memory saw free), straight (a piece of wall seen at a grazing angle), 
 standing mostly on the memory's established obstacles, is a wall and is never
 tracked. The others are
 associated with the tracks predicted to this scan's time (Hungarian assignment,
-scipy, within ``track_gate``) and update their filter; unmatched clusters start
+scipy, within ``track_gate`` and the prediction's uncertainty: GATE_CHI2) and update
+their filter; unmatched clusters start
 tentative tracks, and a track unseen for MAX_MISSES scans is dropped.
 
 The filter (per track, vectorised over all tracks) is the constant-velocity
@@ -43,8 +44,18 @@ from .occupancy import ESTABLISHED
 ACCEL_NOISE = 0.5
 #: Standard deviation of a centroid measurement [m].
 MEASUREMENT_SIGMA = 0.05
-#: Initial standard deviation of a new track's velocity [m/s].
-INITIAL_SPEED_SIGMA = 0.5
+#: Initial standard deviation of a new track's velocity [m/s]: a walker at up to 1.5 m/s
+#: is in the gate of the track it started at the next scan.
+INITIAL_SPEED_SIGMA = 1.0
+#: A cluster is associated with a track only within this squared Mahalanobis distance of
+#: the track's prediction (its position's covariance plus MEASUREMENT_SIGMA; chi-square,
+#: 2 degrees of freedom, 95 %), as well as within ``track_gate``. A track that has stood
+#: still for a few scans is sure of where it is and that it does not move: the centroid
+#: of another piece of clutter 0.3 m away is not its next measurement, where a distance
+#: gate alone let a track hop from piece to piece, gather the hops as speed and move
+#: (static clutter through a realistic lidar). A new track's uncertain velocity still
+#: lets it follow a walker.
+GATE_CHI2 = 5.99
 #: Scans a track may go unseen before it is dropped.
 MAX_MISSES = 3
 #: Scans before a track's speed says whether it moves.
@@ -289,9 +300,13 @@ class Tracker:
         if n_tracks and small.size:
             # each track where it was when the sweep saw each cluster
             at = self.x[:, None, :2] + lag[None, small, None] * self.x[:, None, 2:]
-            cost = np.hypot(*(at - cents[None, small]).transpose(2, 0, 1))
-            rows, cols = linear_sum_assignment(np.where(cost <= self.gate, cost, 1e6))
-            ok = cost[rows, cols] <= self.gate
+            diff = cents[None, small] - at
+            cost = np.hypot(*diff.transpose(2, 0, 1))
+            s_inv = np.linalg.inv(self.P[:, :2, :2] + MEASUREMENT_SIGMA ** 2 * np.eye(2))
+            near = (cost <= self.gate) \
+                & (np.einsum('tki,tij,tkj->tk', diff, s_inv, diff) <= GATE_CHI2)
+            rows, cols = linear_sum_assignment(np.where(near, cost, 1e6))
+            ok = near[rows, cols]
             rows, cols = rows[ok], cols[ok]
             self._correct(rows, cents[small[cols]], lag[small[cols]])
             track_of[small[cols]] = rows
