@@ -8,7 +8,7 @@ from subapf_planner.core.config import PlannerConfig
 from subapf_planner.sim.episode import run_episode
 from subapf_planner.sim.simulator import SimConfig
 from subapf_planner.sim.world import load_world
-from subapf_planner.tools.bench import DEFAULT_METHODS, main
+from subapf_planner.tools.bench import DEFAULT_METHODS, given_up, main
 from subapf_planner.tools.plots import method_style
 
 pytestmark = pytest.mark.sim
@@ -17,7 +17,7 @@ pytestmark = pytest.mark.sim
 PAPER = PlannerConfig(attraction_field='euclidean')
 KEYS = {'world', 'method', 'outcome', 'time_s', 'path_length', 'min_clearance',
         'mean_abs_curvature', 'plan_ms_median', 'plan_ms_p99', 'cycles', 'shortest_path',
-        'time_over_limit', 'path_over_shortest'}
+        'time_over_limit', 'path_over_shortest', 'final_state'}
 
 
 def test_short_bench_writes_consistent_results(tmp_path, worlds_dir):
@@ -36,6 +36,7 @@ def test_short_bench_writes_consistent_results(tmp_path, worlds_dir):
         # both planners pass both open worlds (docs/results.md, the shipped worlds), without
         # touching anything, and the run's record agrees with itself
         assert r['outcome'] == 'reached', r
+        assert r['final_state'] == 'reached: goal within tolerance'
         assert r['final_distance'] <= r['goal_tolerance']
         straight = 5.0 if r['world'] == 'four_points' else 4.0
         assert r['path_length'] >= straight - r['goal_tolerance'] - 0.05
@@ -50,6 +51,16 @@ def test_short_bench_writes_consistent_results(tmp_path, worlds_dir):
         assert r['time_over_limit'] >= 0.9 and r['path_over_shortest'] >= 0.9
     assert (out / 'summary.md').read_text().startswith('| method |')
     assert (out / 'four_points.png').stat().st_size > 10_000
+
+
+def test_the_summary_lists_the_runs_given_up_with_why():
+    runs = [{'world': 'a', 'method': 'm', 'outcome': 'reached', 'final_state': 'reached: x'},
+            {'world': 'b', 'method': 'm', 'outcome': 'unreachable',
+             'final_state': 'unreachable: no way to the goal for 30 s (the walls in the '
+                            'memory close every way), goal abandoned'}]
+    table = given_up(runs)
+    assert '| b | m | unreachable | unreachable: no way to the goal for 30 s (the walls' in table
+    assert '| a |' not in table and given_up(runs[:1]) == ''
 
 
 def test_bench_rejects_unknown_method_and_bad_world(tmp_path, capsys):

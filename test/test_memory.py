@@ -90,17 +90,20 @@ def test_window_reaches_towards_a_far_goal():
 
 
 # --- the field ------------------------------------------------------------------------
-def field_on(occ, goal, robot=(0.1, 0.1), inflation=0.0, soft=0.0, coarsening=1):
-    return compute_field(occ, (0.0, 0.0), RES, goal, robot, inflation, soft, coarsening)
+def field_on(occ, goal, robot=(0.1, 0.1), inflation=0.0, soft=0.0, coarsening=1, route=None,
+             discount=0.0):
+    return compute_field(occ, (0.0, 0.0), RES, goal, robot, inflation, soft, coarsening,
+                         route, discount, 0.3)
 
 
 @settings(max_examples=80, deadline=None)
 @given(seed=st.integers(0, 2**31 - 1), fill=st.floats(0.0, 0.35),
        inflation=st.sampled_from([0.0, 0.06, 0.125]), soft=st.sampled_from([0.0, 0.2]),
-       coarsening=st.sampled_from([1, 2, 3]))
-def test_no_local_minimum_but_the_goal(seed, fill, inflation, soft, coarsening):
+       coarsening=st.sampled_from([1, 2, 3]), discount=st.sampled_from([0.0, 0.2, 0.6]))
+def test_no_local_minimum_but_the_goal(seed, fill, inflation, soft, coarsening, discount):
     """Every reachable cell but the goal's has an 8-neighbour with a strictly lower value
-    (on the cells the field is marched on: map cells, or blocks of them)."""
+    (on the cells the field is marched on: map cells, or blocks of them), also with a
+    route favoured (any polyline: the route_discount hysteresis keeps the guarantee)."""
     rng = np.random.default_rng(seed)
     occ = rng.random((40, 40)) < fill
     free = np.argwhere(~occ)
@@ -108,7 +111,8 @@ def test_no_local_minimum_but_the_goal(seed, fill, inflation, soft, coarsening):
         return
     gr, gc = free[rng.integers(len(free))]
     goal = ((gc + 0.5) * RES, (gr + 0.5) * RES)
-    f = field_on(occ, goal, goal, inflation, soft, coarsening)
+    route = np.cumsum(rng.normal(0.0, 0.1, (30, 2)), axis=0) + rng.random(2) * 40 * RES
+    f = field_on(occ, goal, goal, inflation, soft, coarsening, route, discount)
     if f is None:                               # goal inside the inflation
         return
     v = f.values                                # (the patch the field was computed on)
@@ -189,6 +193,36 @@ def test_a_gap_the_blocks_close_is_marched_on_the_map_cells():
     assert coarse.value(robot)[0] == pytest.approx(2.0, abs=0.1)   # straight through
 
 
+def _two_ways(shift):
+    """A 6 m x 6 m map with a 3 m wide block across the middle, ``shift`` [m] right of
+    centre: the robot at (3, 0.5) and the goal at (3, 5.5) have a way round either side."""
+    occ = np.zeros((120, 120), bool)
+    c0 = int(round((1.5 + shift) / RES))
+    occ[50:70, c0:c0 + 60] = True
+    return occ
+
+
+def _side(path, shift):
+    """The side of the block a path passes ('left', 'right')."""
+    middle = path[np.argmin(np.abs(path[:, 1] - 3.0))]
+    return 'left' if middle[0] < 3.0 + shift else 'right'
+
+
+def test_the_route_taken_is_kept_until_another_way_is_clearly_shorter():
+    """route_discount: the field leads the robot on round the side it has taken while the
+    other way is less than the discount shorter (no dithering between two near-equal
+    ways), and round the other once it is clearly shorter."""
+    robot, goal = (3.0, 0.5), (3.0, 5.5)
+    taken = field_on(_two_ways(-0.1), goal, robot, 0.105, 0.22, 2).path(robot)
+    assert _side(taken, -0.1) == 'right'      # the shorter way when it was taken
+    for shift, expected in ((0.1, 'right'), (0.3, 'right'), (0.6, 'left')):
+        # (in the field's metres the right way 4 %, 13 %, 28 % longer than the left)
+        assert _side(field_on(_two_ways(shift), goal, robot, 0.105, 0.22, 2).path(robot),
+                     shift) == 'left'         # without the route: the shorter way
+        kept = field_on(_two_ways(shift), goal, robot, 0.105, 0.22, 2, taken, 0.2)
+        assert _side(kept.path(robot), shift) == expected
+
+
 def test_goal_in_an_inflated_obstacle_has_no_field():
     occ = np.zeros((60, 60), bool)
     occ[30, 30] = True
@@ -208,11 +242,33 @@ def test_planner_stops_for_an_enclosed_goal_and_drives_when_it_opens():
     for k in range(3):
         res = planner.step(pose, goal, Scan(ranges, amin, inc, rmin, rmax, k), now=k)
     assert res.command.status is Status.GOAL_UNREACHABLE and res.command.v == 0.0
+    assert res.no_way == 'the walls in the memory close every way'
     ranges[-30:] = np.inf                        # an opening appears (and stays)
     ranges[:30] = np.inf
     for k in range(3, 12):
         res = planner.step(pose, goal, Scan(ranges, amin, inc, rmin, rmax, k), now=k)
     assert res.command.status is not Status.GOAL_UNREACHABLE
+
+
+def test_the_memory_says_why_it_holds_no_way():
+    """NavigationMemory.no_way: what closes the way, for the unreachable state's reason
+    and the bench (a goal in a wall, the walls, places tried)."""
+    mem = NavigationMemory(PlannerConfig(field_worker=False))
+    ranges, amin, inc, rmin, rmax = enclosure_scan(1.0)
+    ranges = ranges.copy()
+    ranges[:20] = ranges[-20:] = np.inf      # a ring of radius 1 m, open towards +x
+    mem.integrate(Scan(ranges, amin, inc, rmin, rmax, 0.0), (0.0, 0.0, 0.0))
+    assert mem.no_way((0.0, 0.0), (0.0, 1.0)) \
+        == 'the goal is within inflation_radius of a wall in the memory'
+    field, _ = mem.field_for((0.0, 0.0), (3.0, 0.0), now=0.0)
+    assert field.reachable((0.0, 0.0))      # out through the opening
+    mem.avoid((1.0, 0.0), 0.4, until=10.0)   # the opening tried
+    field, _ = mem.field_for((0.0, 0.0), (3.0, 0.0), now=1.0)
+    assert not field.reachable((0.0, 0.0))
+    assert mem.no_way((0.0, 0.0), (3.0, 0.0)) == 'every way through the walls tried'
+    mem.integrate(Scan(*enclosure_scan(1.0), 1.0), (0.0, 0.0, 0.0))   # the ring closes
+    assert mem.no_way((0.0, 0.0), (3.0, 0.0)) == 'the walls in the memory close every way'
+    assert mem.no_way((0.0, 0.0), (30.0, 0.0)).endswith('taken at its edge)')
 
 
 def _first_fields(cfg: PlannerConfig) -> NavigationMemory:
@@ -247,11 +303,10 @@ def test_with_the_worker_the_map_changes_reach_the_field_at_the_next_call():
     assert any(t.name.startswith('field') for t in threading.enumerate())
     after, new = mem.field_for((0, 0), (0.0, 1.0), now=1.7)
     assert new and after is not before   # ... and taken at the next call
-    # the field marched in the worker is the one the cycle would have computed
-    alone = NavigationMemory(cfg)
-    for r, t in ((2.0, 0.0), (1.5, 0.2), (1.2, 1.5)):
-        alone.integrate(Scan(*enclosure_scan(r), t), (0.0, 0.0, 0.0))
-    np.testing.assert_array_equal(alone.field_for((0, 0), (0.0, 1.0), -math.inf)[0].values,
+    # the field marched in the worker is the one the cycle would have computed (from the
+    # same map and the same route)
+    alone = _first_fields(cfg.replace(field_worker=False))
+    np.testing.assert_array_equal(alone.field_for((0, 0), (0.0, 1.0), now=1.5)[0].values,
                                   after.values)
 
 

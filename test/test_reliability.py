@@ -316,7 +316,8 @@ def test_goal_unreachable_is_given_up_after_its_timeout_unless_a_way_opens():
     assert texts[10] == 'driving: driving'                      # a way: the clock restarts
     given_up = next(k for k, t in enumerate(texts) if t.startswith('unreachable'))
     assert given_up == 11 + 13                  # more than 3 s of it since tick 11
-    assert texts[given_up] == 'unreachable: no way to the goal for 3 s, goal abandoned'
+    assert texts[given_up] == ('unreachable: no way to the goal for 3 s (goal_unreachable), '
+                               'goal abandoned')   # (a memory says why: no_way)
     assert all(t == texts[given_up] for t in texts[given_up:])
     assert ctl.tick(9.0).command == (0.0, 0.0)
     assert ctl.set_goal(np.array([5.0, 0.0]))                  # sent again: a new attempt

@@ -140,6 +140,15 @@ class PlannerConfig:
     inflation_band: float = param(0.22, 'Field: beyond inflation_radius, travel speeds up '
                                   'linearly to full over this band, so the field keeps to the '
                                   'middle of passages', 'm', 0.0, 2.0)
+    route_discount: float = param(0.0, 'Field: travel along the route the robot has taken '
+                                  "to the goal (the last field's descent from where it was, "
+                                  'route_width either side) costs this fraction less, so '
+                                  'another way must be that much shorter to take over (no '
+                                  'dithering between two near-equal ways; 0, the default: '
+                                  'none; docs/memory.md)', '',
+                                  0.0, 0.9)
+    route_width: float = param(0.3, 'Field: half-width of the route route_discount favours',
+                               'm', 0.0, 2.0)
     field_period: float = param(1.0, 'Shortest time between two field computations (sooner '
                                 'for a new goal, or when the robot leaves the patch)', 's',
                                 0.0, 60.0)

@@ -58,6 +58,8 @@ class PlanResult:
     pose: NDArray[np.float64] | None = None
     #: ... which is odom corrected by this (x, y, yaw) (the scan alignment; Planner.step).
     correction: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    #: With goal_unreachable: why the memory holds no way (NavigationMemory.no_way).
+    no_way: str = ''
 
 
 @dataclass(frozen=True)
@@ -90,6 +92,8 @@ class Cycle:
     #: The navigation field (None: the Euclidean attraction) and whether it is new.
     field: NavigationField | None = None
     new_field: bool = False
+    #: With goal_unreachable: why the memory holds no way (NavigationMemory.no_way).
+    no_way: str = ''
     #: Set by a gate: the cycle stops the robot with this status.
     status: Status | None = None
     #: The command and what led to it: set by the proposer (or, for a stopped cycle,
@@ -104,7 +108,7 @@ class Cycle:
         """The diagnostics every PlanResult of the cycle carries."""
         return dict(obstacles=self.obstacles, nearest_distance=self.nearest_distance,
                     goal_distance=self.goal_distance, field=self.field,
-                    new_field=self.new_field, tracks=self.tracks)
+                    new_field=self.new_field, tracks=self.tracks, no_way=self.no_way)
 
     def stopped(self) -> Cycle:
         """The cycle with the result of standing still with its ``status``."""

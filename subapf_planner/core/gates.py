@@ -111,7 +111,7 @@ class Mapping(Stage):
 class Reachability(Stage):
     """The navigation field to the goal through the memory (core/memory.py);
     ``goal_unreachable`` when there is none or the robot's position has no value in it
-    (no way)."""
+    (no way; why: NavigationMemory.no_way)."""
 
     name = 'reachability'
 
@@ -120,6 +120,7 @@ class Reachability(Stage):
 
     def run(self, cycle: Cycle) -> Cycle:
         field, new = self.memory.field_for(cycle.pose[:2], cycle.goal, cycle.now)
-        status = None if field is not None and field.reachable(cycle.pose[:2]) \
-            else Status.GOAL_UNREACHABLE
-        return cycle.with_(field=field, new_field=new, status=status)
+        if field is not None and field.reachable(cycle.pose[:2]):
+            return cycle.with_(field=field, new_field=new)
+        return cycle.with_(field=field, new_field=new, status=Status.GOAL_UNREACHABLE,
+                           no_way=self.memory.no_way(cycle.pose[:2], cycle.goal))

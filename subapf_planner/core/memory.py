@@ -28,6 +28,7 @@ import weakref
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
+from scipy import ndimage
 
 from .alignment import DistanceField, Match, align, distance_field
 from .config import PlannerConfig
@@ -46,6 +47,9 @@ DISTANCE_FIELD_SCANS = 5
 DISTANCE_FIELD_MARGIN = 1.0
 #: Returns this far beyond a moving track's disc are the alignment's again [m].
 MOVING_MARGIN = 0.3
+#: The route a field favours is its descent this far from the robot [m] (beyond the
+#: window's 20 m side: to the goal, or out of the window towards it).
+ROUTE_LENGTH = 60.0
 
 
 def _grid_settings(cfg: PlannerConfig) -> tuple[float, float, bool]:
@@ -73,6 +77,8 @@ class FieldJob:
     key: tuple
     #: When the cycle took the map [s].
     time: float
+    #: The way the robot has taken to the goal, the field favours (compute_field's route).
+    route: NDArray[np.float64] | None = None
 
 
 class NavigationMemory:
@@ -98,6 +104,10 @@ class NavigationMemory:
         #: ... and once started, the field being marched in the worker, and its job.
         self._pending: tuple[Future, FieldJob] | None = None
         self._worker: ThreadPoolExecutor | None = None
+        #: The last field's descent from where the robot was (x, y) (k, 2) [m], and the
+        #: goal key it leads to: the next field of that goal favours it (route_discount).
+        self.route: NDArray[np.float64] | None = None
+        self._route_goal: tuple | None = None
 
     def reconfigure(self, cfg: PlannerConfig) -> None:
         """A new configuration; a new map size or resolution, or the scan alignment
@@ -116,6 +126,7 @@ class NavigationMemory:
         self._scan_stamp = None
         self._distance, self._distance_age = None, 0
         self.avoided = []
+        self.route, self._route_goal = None, None
         self._drop_pending()
 
     def _drop_pending(self) -> None:
@@ -137,7 +148,7 @@ class NavigationMemory:
             self._worker = ThreadPoolExecutor(max_workers=1, thread_name_prefix='field')
             weakref.finalize(self, self._worker.shutdown, wait=False)
         self._pending = (self._worker.submit(self._compute, job.blocked, job.origin, job.goal,
-                                             job.position), job)
+                                             job.position, job.route), job)
 
     def settle(self) -> None:
         """Start the field due and wait until it is done; the next call takes it as it
@@ -150,24 +161,35 @@ class NavigationMemory:
     def _march_later(self, goal: NDArray, position: NDArray, now: float) -> None:
         """Take the map as it is now for a field to march between cycles
         (start_marching); the next call takes that field."""
+        key = self._key(goal)
         self._due = FieldJob(self._blocked(now), self.grid.origin.copy(), goal, position,
-                             self._key(goal), now)
+                             key, now, self._route_for(key))
 
     def _compute(self, blocked: NDArray[np.bool_], origin: NDArray, goal: NDArray,
-                 position: NDArray) -> tuple[NavigationField | None, float]:
-        """The field, and how long it took [s]."""
+                 position: NDArray, route: NDArray | None
+                 ) -> tuple[NavigationField | None, float, NDArray | None]:
+        """The field, how long it took [s], and its descent from ``position`` (the route
+        the next field favours)."""
         cfg = self.cfg
         t0 = time.perf_counter()
         field = compute_field(blocked, origin, self.grid.resolution, goal, position,
                               inflation_radius=cfg.inflation_radius,
                               clearance_band=cfg.inflation_band,
-                              coarsening=cfg.field_coarsening)
-        return field, time.perf_counter() - t0
+                              coarsening=cfg.field_coarsening, route=route,
+                              route_discount=cfg.route_discount, route_width=cfg.route_width)
+        seconds = time.perf_counter() - t0
+        return field, seconds, None if field is None else field.path(position, ROUTE_LENGTH)
 
-    def _install(self, computed: tuple[NavigationField | None, float], key: tuple,
-                 when: float) -> None:
-        self.field, self.compute_seconds = computed
+    def _route_for(self, key: tuple) -> NDArray | None:
+        """The route a field for ``key`` favours: the last one, if it led to that goal."""
+        return self.route if self._route_goal == key[0] else None
+
+    def _install(self, computed: tuple[NavigationField | None, float, NDArray | None],
+                 key: tuple, when: float) -> None:
+        self.field, self.compute_seconds, route = computed
         self._field_key, self._field_time = key, when
+        self.route, self._route_goal = (None, None) if route is None or not len(route) \
+            else (route, key[0])
         self.computations += 1
 
     def _key(self, goal: NDArray) -> tuple:
@@ -249,6 +271,33 @@ class NavigationMemory:
             occ[r0:r1, c0:c1] |= (cx[None] - x) ** 2 + (cy[:, None] - y) ** 2 <= r * r
         return occ
 
+    def no_way(self, position: ArrayLike, goal: ArrayLike) -> str:
+        """Why the memory holds no way from ``position`` to ``goal`` (x, y) [m] (a query,
+        for goal_unreachable), at the field's hard inflation (``inflation_radius``):
+        the goal within it of a wall, every way closed by the walls themselves, or only
+        by places tried (``avoid``). A goal beyond the window is taken at its edge (said
+        so)."""
+        g = self.grid
+        occ = g.occupied()
+        clear = ndimage.distance_transform_edt(~occ) * g.resolution if occ.any() \
+            else np.full(occ.shape, np.inf)
+        free = clear >= self.cfg.inflation_radius
+        cells = g.cell_of(np.array([position, goal], float).reshape(2, 2))
+        beyond = '' if g.inside(cells[1:])[0] else ' (the goal beyond the window, taken ' \
+            'at its edge)'
+        robot, target = np.clip(cells, 0, np.array(occ.shape) - 1)
+        if not free[tuple(target)]:
+            return f'the goal is within inflation_radius of a wall in the memory{beyond}'
+        near = np.zeros_like(free)
+        r0, c0 = np.maximum(robot - 3, 0)
+        near[r0:robot[0] + 4, c0:robot[1] + 4] = True   # (field.reachable's 3 cells)
+        labels, _ = ndimage.label(free, structure=np.ones((3, 3)))
+        if not np.isin(labels[free & near], labels[tuple(target)]).any():
+            return f'the walls in the memory close every way{beyond}'
+        if self.avoided:
+            return f'every way through the walls tried{beyond}'
+        return f"no way at the field's resolution{beyond}"
+
     def clear(self, points: ArrayLike) -> None:
         """Cells under ``points`` (n, 2) [m] that are occupied become unknown: something
         that moved stood there (core/tracking.py's trail)."""
@@ -327,5 +376,6 @@ class NavigationMemory:
             self._march_later(g, p, now)   # only the map's changes: the next call has it
             return self.field, self.computations != installed
         self._install(self._compute(self._blocked(now if timed else None), self.grid.origin,
-                                    g, p), key, now if timed else -math.inf)
+                                    g, p, self._route_for(key)), key,
+                      now if timed else -math.inf)
         return self.field, True

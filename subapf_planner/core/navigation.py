@@ -246,7 +246,9 @@ def crop_box(occupied: NDArray[np.bool_], cells: NDArray[np.int64],
 
 def compute_field(occupied: NDArray[np.bool_], origin: ArrayLike, resolution: float,
                   goal: ArrayLike, robot: ArrayLike, inflation_radius: float,
-                  clearance_band: float, coarsening: int = 1) -> NavigationField | None:
+                  clearance_band: float, coarsening: int = 1, route: ArrayLike | None = None,
+                  route_discount: float = 0.0,
+                  route_width: float = 0.0) -> NavigationField | None:
     """The navigation field to ``goal`` on an occupancy grid (see the module docstring).
 
     ``coarsening`` > 1 marches on blocks of that many cells a side (fast marching
@@ -258,6 +260,8 @@ def compute_field(occupied: NDArray[np.bool_], origin: ArrayLike, resolution: fl
     ``goal`` outside the grid is replaced by the nearest cell of the grid's border.
     ``inflation_radius`` [m]: the hard inflation (the robot's footprint; see the module
     docstring) and ``clearance_band`` [m] the band beyond it where travel speeds up.
+    ``route`` (k, 2) [m]: the way the robot has taken (the last field's ``path``); travel
+    within ``route_width`` [m] of it is ``route_discount`` cheaper (route_speed).
     Returns None when the goal cell is within ``inflation_radius`` of an occupied cell.
     """
     origin = np.asarray(origin, float)
@@ -286,10 +290,13 @@ def compute_field(occupied: NDArray[np.bool_], origin: ArrayLike, resolution: fl
     if k > 1:   # (the speed is monotone in the clearance: a block's from its largest)
         occ, clear = _blocks(occ, k, np.logical_or), _blocks(clear, k, np.maximum)
     speed = np.clip((clear - inflation_radius) / max(clearance_band, 1e-9), MIN_SPEED, 1.0)
+    patch_origin = origin + np.array([c0, r0]) * resolution
+    if route is not None and route_discount > 0.0:
+        speed = route_speed(speed, patch_origin, k * resolution, route, route_discount,
+                            route_width)
     values = _travel_distance(occ, speed, (g_local[0] // k, g_local[1] // k), k * resolution)
     if values is None:
         return None
-    patch_origin = origin + np.array([c0, r0]) * resolution
     goal_used = g if (0 <= (g - origin)[0] < w * resolution
                       and 0 <= (g - origin)[1] < h * resolution) \
         else origin + (gc[::-1] + 0.5) * resolution
@@ -297,8 +304,29 @@ def compute_field(occupied: NDArray[np.bool_], origin: ArrayLike, resolution: fl
                             resolution)
     if k > 1 and field.reachable(robot) and not np.isfinite(field.value(robot)[0]):
         return compute_field(occupied, origin, resolution, goal, robot, inflation_radius,
-                             clearance_band, 1)
+                             clearance_band, 1, route, route_discount, route_width)
     return field
+
+
+def route_speed(speed: NDArray[np.float64], origin: ArrayLike, cell: float, route: ArrayLike,
+                discount: float, width: float) -> NDArray[np.float64]:
+    """``speed`` (relative, on cells of ``cell`` [m] from ``origin``) divided by
+    1 - ``discount`` within ``width`` [m] of the polyline ``route`` (k, 2) [m]: travel
+    along the way the robot has taken costs ``discount`` less, so another way takes over
+    only when it is that much shorter (hysteresis between near-equal ways). Every speed
+    stays positive and finite: the field is still a distance with one minimum, the goal.
+    Route points off the patch are left out."""
+    r = np.asarray(route, float).reshape(-1, 2)
+    h, w = speed.shape
+    cells = np.floor((r - np.asarray(origin, float)) / cell).astype(np.int64)[:, ::-1]
+    cells = cells[(cells[:, 0] >= 0) & (cells[:, 0] < h) & (cells[:, 1] >= 0)
+                  & (cells[:, 1] < w)]
+    if not len(cells) or not 0.0 < discount < 1.0:
+        return speed
+    on = np.zeros((h, w), bool)
+    on[cells[:, 0], cells[:, 1]] = True
+    near = ndimage.distance_transform_edt(~on) * cell <= width
+    return np.where(near, speed / (1.0 - discount), speed)
 
 
 def _blocks(a: NDArray, k: int, combine: np.ufunc) -> NDArray:

@@ -133,8 +133,9 @@ class Unreachable(Supervisor):
         if now - self._since <= timeout:
             return None
         tried = loop.recoveries.tried
-        return loop.stop(State.UNREACHABLE, f'no way to the goal for {timeout:g} s'
-                         f'{f" (every way tried: {tried})" if tried else ""}, goal abandoned',
+        why = result.no_way or str(result.command.status)
+        return loop.stop(State.UNREACHABLE, f'no way to the goal for {timeout:g} s ({why}'
+                         f'{f"; ways tried: {tried}" if tried else ""}), goal abandoned',
                          result)
 
 

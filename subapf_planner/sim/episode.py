@@ -64,6 +64,9 @@ class EpisodeResult:
     moving_world: bool = False
     #: Per planning cycle (with pose_error), odometry's own distance to the true pose [m].
     odom_error: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    #: The decision loop's state and reason at the end ('unreachable: no way to the goal
+    #: for 30 s (why), goal abandoned').
+    final_state: str = ''
 
     @property
     def cycles(self) -> int:
@@ -95,6 +98,7 @@ class EpisodeResult:
             if self.odom_error.size else None,
             'evading_cycles': int(self.statuses.get('evading', 0)),
             'moving_world': self.moving_world,
+            'final_state': self.final_state,
         }
 
 
@@ -162,4 +166,4 @@ def run_episode(world: World, cfg: PlannerConfig, sim_cfg: SimConfig | None = No
                          np.asarray(plan_ms), final, statuses, np.asarray(recomputed, bool),
                          np.asarray(times), hit_while_stopped, np.asarray(field_ms),
                          np.asarray(after_ms), np.asarray(pose_error), bool(world.moving),
-                         np.asarray(odom_error))
+                         np.asarray(odom_error), ctl.text)

@@ -190,6 +190,18 @@ def _collisions(runs: list[dict]) -> str:
     return f'{len(hits)} ({stopped} stopped)' if stopped else str(len(hits))
 
 
+def given_up(runs: list[dict]) -> str:
+    """The runs the planner gave up (``unreachable``, ``abandoned``) and why, as the
+    decision loop said it at the end (``final_state``); empty when there are none."""
+    rows = [r for r in runs if r['outcome'] in ('unreachable', 'abandoned')]
+    if not rows:
+        return ''
+    lines = ['| world | method | outcome | final state |', '|---|---|---|---|']
+    lines += [f"| {r['world']} | {r['method']} | {r['outcome']} | {r.get('final_state', '')} |"
+              for r in rows]
+    return 'Runs given up:\n\n' + '\n'.join(lines) + '\n'
+
+
 def family_of(world: str) -> str:
     """A generated world's family: its name without the index (``arena_007`` -> arena)."""
     head, _, tail = world.rpartition('_')
@@ -452,6 +464,7 @@ def main(argv: list[str] | None = None) -> int:
     (out / 'summary.md').write_text(summarise(runs, labels) + '\n' + by_family(runs, labels)
                                     + '\n' + perception(runs, labels)
                                     + '\n' + speed(runs, labels)
+                                    + '\n' + given_up(runs)
                                     + '\n' + paired(runs, labels)
                                     + f'\n{len(runs)} runs in {wall:.1f} s wall time.\n')
     print((out / 'summary.md').read_text())
