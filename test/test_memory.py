@@ -221,6 +221,12 @@ def test_the_route_taken_is_kept_until_another_way_is_clearly_shorter():
                      shift) == 'left'         # without the route: the shorter way
         kept = field_on(_two_ways(shift), goal, robot, 0.105, 0.22, 2, taken, 0.2)
         assert _side(kept.path(robot), shift) == expected
+    # the memory keeps each field's descent as the next one's route, with the discount only
+    for discount, kept in ((0.2, True), (0.0, False)):
+        mem = NavigationMemory(PlannerConfig(route_discount=discount, field_worker=False))
+        mem.field_for((0.0, 0.0), (2.0, 0.0), -math.inf)
+        assert bool(mem.route is not None
+                    and np.hypot(*(mem.route[-1] - (2.0, 0.0))) < 0.1) is kept
 
 
 def test_goal_in_an_inflated_obstacle_has_no_field():

@@ -168,8 +168,8 @@ class NavigationMemory:
     def _compute(self, blocked: NDArray[np.bool_], origin: NDArray, goal: NDArray,
                  position: NDArray, route: NDArray | None
                  ) -> tuple[NavigationField | None, float, NDArray | None]:
-        """The field, how long it took [s], and its descent from ``position`` (the route
-        the next field favours)."""
+        """The field, how long it took [s], and, with route_discount, its descent from
+        ``position`` (the route the next field favours)."""
         cfg = self.cfg
         t0 = time.perf_counter()
         field = compute_field(blocked, origin, self.grid.resolution, goal, position,
@@ -178,7 +178,9 @@ class NavigationMemory:
                               coarsening=cfg.field_coarsening, route=route,
                               route_discount=cfg.route_discount, route_width=cfg.route_width)
         seconds = time.perf_counter() - t0
-        return field, seconds, None if field is None else field.path(position, ROUTE_LENGTH)
+        if field is None or cfg.route_discount <= 0.0:
+            return field, seconds, None
+        return field, seconds, field.path(position, ROUTE_LENGTH)
 
     def _route_for(self, key: tuple) -> NDArray | None:
         """The route a field for ``key`` favours: the last one, if it led to that goal."""
