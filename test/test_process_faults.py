@@ -71,8 +71,13 @@ class Graph:
         self.children.append(self.planner)
 
     def logs(self):
-        return '\n'.join(f'--- {f.name}\n' + f.read_text()[-3000:]
-                         for f in sorted(self.log_dir.glob('*.log')))
+        statuses = []   # the planner's status, each change once
+        for s in self.status:
+            if not statuses or statuses[-1] != s:
+                statuses.append(s)
+        return '\n'.join([f'--- {f.name}\n' + f.read_text()[-3000:]
+                           for f in sorted(self.log_dir.glob('*.log'))]
+                          + ['--- status (changes)'] + statuses[-40:])
 
     def spin_until(self, predicate, timeout):
         end = time.monotonic() + timeout

@@ -222,6 +222,24 @@ def test_nan_pose_dropped_and_quaternion_normalised(node):
     assert node.ctl.pose[2] == pytest.approx(math.pi / 2)
 
 
+def test_inputs_stamped_ahead_of_the_clock_are_dropped(node):
+    """What a killed simulator had in flight, stamped before its successor's clock went
+    back to zero, is not taken as the new simulation's scan and odometry."""
+    ahead = node.get_clock().now().nanoseconds // 10**9 + 10   # [s]
+    scan = scan_msg(FREE, 0.0, math.pi / 180, 0.12, 3.5, 'base_scan')
+    scan.header.stamp.sec = ahead
+    cap = Captured(node)
+    node._on_goal(goal_msg(3.0, 0.0))
+    node._on_scan(scan)
+    node._on_odom(odom_msg(0.0, 0.0, (0, 0, 0, 1), stamp=ahead))
+    node._on_timer()
+    assert node.ctl.scan is None and node.ctl.pose is None
+    assert cap.decisions[-1].text == 'waiting: no scan yet' and not cap.cmds
+    scan.header.stamp.sec = ahead - 10   # the clock's own time: taken
+    node._on_scan(scan)
+    assert node.ctl.scan is not None
+
+
 def test_odometry_time_going_back_clears_history():
     ctl = DecisionLoop(CFG)
     assert ctl.update_odom(5.0, np.zeros(3), 5.0)

@@ -39,6 +39,9 @@ from .supervisors import SUPERVISORS, Recoveries
 POSE_HISTORY = 100
 #: A scan is placed with the odometry pose nearest its stamp, if within this [s].
 POSE_MATCH = 0.1
+#: An input stamped more than this [s] after the clock is not taken: it was sent before
+#: the clock jumped back (a restarted simulation) or by a clock out of step.
+FUTURE_STAMP = 1.0
 
 
 @dataclass(frozen=True)

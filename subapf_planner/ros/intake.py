@@ -5,6 +5,9 @@ and returns what a person should be told (None: nothing), so the node logs it
 (throttled) and the in-process replay (ros/replay.py) takes the same messages
 in the same way:
 
+* a scan or odometry stamped more than FUTURE_STAMP after the clock is dropped
+  (sent before the clock jumped back: a restarted simulator's last messages must not
+  be taken as its successor's);
 * a scan in a frame other than ``laser_frame`` (empty: any) is dropped; a scan
   whose ranges do not match its header is used (LDS-02 varies its count) with a
   warning;
@@ -25,7 +28,7 @@ from nav_msgs.msg import Odometry
 import numpy as np
 from sensor_msgs.msg import LaserScan
 
-from ..core.loop import DecisionLoop
+from ..core.loop import FUTURE_STAMP, DecisionLoop
 from ..core.scan import geometry_warning
 from .conversions import pose_from_odom, scan_from_msg, stamp_to_seconds
 
@@ -44,6 +47,8 @@ class Intake:
         if self.laser_frame and msg.header.frame_id != self.laser_frame:
             return (f'scan in frame "{msg.header.frame_id}", expected "{self.laser_frame}": '
                     'dropped')
+        if problem := _ahead('scan', msg, now):
+            return problem
         loop.update_scan(scan_from_msg(msg), now)
         problem = geometry_warning(len(msg.ranges), msg.angle_min, msg.angle_max,
                                    msg.angle_increment)
@@ -51,6 +56,8 @@ class Intake:
 
     def odom(self, loop: DecisionLoop, msg: Odometry, now: float) -> str | None:
         """Take odometry handled at ``now`` [s]; a warning, or None."""
+        if problem := _ahead('odometry', msg, now):
+            return problem
         pose = pose_from_odom(msg)
         if not np.all(np.isfinite(pose)):
             return 'odometry with a non-finite pose: dropped'
@@ -68,3 +75,12 @@ class Intake:
         if not np.all(np.isfinite(goal)):
             return False, 'goal with a non-finite position refused'
         return loop.set_goal(goal, in_map=frame == self.map_frame), None
+
+
+def _ahead(what: str, msg, now: float) -> str | None:
+    """Why a message stamped more than FUTURE_STAMP after ``now`` [s] is dropped."""
+    ahead = stamp_to_seconds(msg.header.stamp) - now
+    if ahead > FUTURE_STAMP:
+        return (f'{what} stamped {ahead:.2f} s after the clock (sent before the clock '
+                'jumped back?): dropped')
+    return None
