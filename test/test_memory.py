@@ -256,6 +256,28 @@ def test_planner_stops_for_an_enclosed_goal_and_drives_when_it_opens():
     assert res.command.status is not Status.GOAL_UNREACHABLE
 
 
+@pytest.mark.parametrize('coarsening', [1, 2])
+def test_a_goal_a_few_centimetres_inside_the_inflation_is_led_to_beside_it(coarsening):
+    """A wall along y = 1 m (cells 20-21), the goal 0.125 m from its cells' centres,
+    inside an inflation of 0.15 m: with goal_slack the field leads to the nearest free
+    cell (0.035 m farther out), as the memory's walls are drawn some centimetres thick;
+    without it, or with the goal on the wall, there is no field."""
+    occ = np.zeros((60, 60), bool)
+    occ[20:22, :] = True
+    robot, goal = (1.5, 2.5), (1.525, 1.19)   # 0.115 m from row 21's centres
+
+    def field(goal, slack):
+        return compute_field(occ, (0.0, 0.0), RES, goal, robot, 0.15, 0.2, coarsening,
+                             goal_slack=slack)
+    assert field(goal, 0.0) is None
+    f = field(goal, 0.075)
+    assert f is not None and f.reachable(robot)
+    assert f.goal == pytest.approx((1.525, 1.225))   # 0.15 m from row 21's centres
+    end = f.path(robot, 5.0)[-1]
+    assert np.hypot(*(end - f.goal)) < 0.1 and end[1] > 1.19   # led there, not into the wall
+    assert field((1.525, 1.025), 0.075) is None      # on the wall: 0.1 m to a free cell
+
+
 def test_the_memory_says_why_it_holds_no_way():
     """NavigationMemory.no_way: what closes the way, for the unreachable state's reason
     and the bench (a goal in a wall, the walls, places tried)."""
@@ -264,8 +286,9 @@ def test_the_memory_says_why_it_holds_no_way():
     ranges = ranges.copy()
     ranges[:20] = ranges[-20:] = np.inf      # a ring of radius 1 m, open towards +x
     mem.integrate(Scan(ranges, amin, inc, rmin, rmax, 0.0), (0.0, 0.0, 0.0))
-    assert mem.no_way((0.0, 0.0), (0.0, 1.0)) \
-        == 'the goal is within inflation_radius of a wall in the memory'
+    assert mem.no_way((0.0, 0.0), (0.0, 1.0)) == ('the goal is within inflation_radius of a '
+                                                  'wall in the memory, with no free cell '
+                                                  'within goal_slack')
     field, _ = mem.field_for((0.0, 0.0), (3.0, 0.0), now=0.0)
     assert field.reachable((0.0, 0.0))      # out through the opening
     mem.avoid((1.0, 0.0), 0.4, until=10.0)   # the opening tried

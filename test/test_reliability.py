@@ -315,6 +315,37 @@ def test_goal_behind_a_wall_without_progress_becomes_stuck():
     assert ctl.tick(4.0).command == (0.0, 0.0)
 
 
+def test_standing_with_no_safe_move_starts_a_recovery_after_blocked_timeout():
+    """A gap the local layer finds no safe sample into: the way ahead is marked tried
+    after blocked_timeout of no_safe_move (a cycle that moves restarts that clock), not
+    after progress_timeout; with no recovery left, the goal is given up only on the
+    progress checker's own clock."""
+    ctl = DecisionLoop(CFG, Supervision(blocked_timeout=1.0, progress_timeout=10.0,
+                                        recoveries=2))
+    tried = []
+
+    class Mark:
+        def run(self, memory, pose, distance, radius, until):
+            tried.append(until)
+            return True
+    ctl.recoveries.behaviours = (Mark(),)
+    ctl.set_goal(np.array([5.0, 0.0]))
+    script = iter([Status.NO_SAFE_MOVE] * 4 + [Status.DRIVING] + [Status.NO_SAFE_MOVE] * 100)
+    ctl.planner.step = lambda *a, **k: PlanResult(Command(0.0, 0.0, next(script)))
+    scan = Scan(np.full(360, np.inf), 0.0, math.pi / 180, 0.12, 3.5, 0.0)
+    texts = []
+    for k in range(100):   # ticks 0.25 s apart, the robot standing
+        ctl.update_scan(scan, 0.25 * k)
+        ctl.update_odom(0.25 * k, np.zeros(3), 0.25 * k)
+        texts.append(ctl.tick(0.25 * k).text)
+    marked = [k for k, t in enumerate(texts) if 'marked tried' in t]
+    assert marked == [10, 16]        # more than 1 s of no_safe_move from tick 5, and again
+    assert texts[10] == 'driving: no safe move: the way ahead marked tried (1 of 2), another way'
+    stuck = texts.index('stuck: no progress, goal abandoned')
+    assert stuck == 58               # more than 10 s after the tick after the last recovery
+    assert len(tried) == 2
+
+
 def test_goal_unreachable_is_given_up_after_its_timeout_unless_a_way_opens():
     """goal_unreachable for unreachable_timeout ends the attempt (state unreachable,
     zero velocity, and it stays so); a cycle with a way restarts the clock; the same

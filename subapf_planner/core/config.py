@@ -137,6 +137,13 @@ class PlannerConfig:
                                     'slower; a goal there is unreachable, and so is one that '
                                     'only gaps narrower than twice this lead to)', 'm',
                                     0.0, 2.0)
+    goal_slack: float = param(0.075, 'Field: a goal within inflation_radius of a wall in the '
+                              'memory is replaced by the nearest free cell this close to it '
+                              "(Nav2's planner tolerance: walls drawn through a noisy lidar "
+                              'are some centimetres thick), and it is inside an obstacle '
+                              'only with a laser point within robot_radius - goal_slack; '
+                              '0: such a goal is unreachable. Keep it under goal_tolerance',
+                              'm', 0.0, 1.0)
     inflation_band: float = param(0.22, 'Field: beyond inflation_radius, travel speeds up '
                                   'linearly to full over this band, so the field keeps to the '
                                   'middle of passages', 'm', 0.0, 2.0)

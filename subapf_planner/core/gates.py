@@ -47,11 +47,13 @@ def input_status(pose: ArrayLike, goal: ArrayLike) -> Status | None:
 def goal_status(cfg: PlannerConfig, goal_distance: float, goal: NDArray[np.float64],
                 obstacles: NDArray[np.float64]) -> Status | None:
     """``reached`` within goal_tolerance of the goal, ``goal_in_obstacle`` when a laser
-    point lies within robot_radius of it (the robot could not stand there); None
-    otherwise."""
+    point lies within robot_radius of it (the robot could not stand there; with the
+    memory, within robot_radius - goal_slack: the field leads to a place up to
+    goal_slack from a goal a noisy lidar shows too close to a wall); None otherwise."""
     if goal_distance <= cfg.goal_tolerance:
         return Status.REACHED
-    if float(clearance(goal, obstacles)[0]) < cfg.robot_radius:
+    slack = cfg.goal_slack if cfg.geodesic else 0.0
+    if float(clearance(goal, obstacles)[0]) < cfg.robot_radius - slack:
         return Status.GOAL_IN_OBSTACLE
     return None
 

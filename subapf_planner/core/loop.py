@@ -57,6 +57,12 @@ class Supervision:
                                      '(state stuck)', 'm', 0.01, 10.0)
     progress_timeout: float = param(10.0, 'Progress checker: time allowed for '
                                     'progress_distance', 's', 1.0, 600.0)
+    blocked_timeout: float = param(3.0, 'Progress checker: standing this long with '
+                                   'no_safe_move (the local layer finds no safe sample '
+                                   'where the field leads, nobody to give way to) starts '
+                                   'the recovery without waiting for progress_timeout: a gap '
+                                   'that turns out impassable is tried for seconds, not a '
+                                   'minute', 's', 0.2, 600.0)
     recoveries: int = param(3, 'Times the progress checker, before it abandons the goal, '
                             'marks the place the field leads into as tried (blocked in the '
                             'field for avoid_time) so that the field leads along another way',

@@ -32,7 +32,7 @@ from scipy import ndimage
 
 from .alignment import DistanceField, Match, align, distance_field
 from .config import PlannerConfig
-from .navigation import NavigationField, compute_field
+from .navigation import NavigationField, compute_field, nearest_free
 from .occupancy import ESTABLISHED, NOT_ESTABLISHED, OccupancyGrid
 from .robot import compose, to_parent
 from .scan import Scan
@@ -165,6 +165,13 @@ class NavigationMemory:
         self._due = FieldJob(self._blocked(now), self.grid.origin.copy(), goal, position,
                              key, now, self._route_for(key))
 
+    @property
+    def slow_radius(self) -> float:
+        """Where the field is as slow as in contact [m] (compute_field): the sampling's
+        clearance from the laser's points, plus half a cell (a wall's surface lies
+        anywhere in its cell, the distances are from the cells' centres)."""
+        return self.cfg.discard_distance + 0.5 * self.grid.resolution
+
     def _compute(self, blocked: NDArray[np.bool_], origin: NDArray, goal: NDArray,
                  position: NDArray, route: NDArray | None
                  ) -> tuple[NavigationField | None, float, NDArray | None]:
@@ -176,7 +183,8 @@ class NavigationMemory:
                               inflation_radius=cfg.inflation_radius,
                               clearance_band=cfg.inflation_band,
                               coarsening=cfg.field_coarsening, route=route,
-                              route_discount=cfg.route_discount, route_width=cfg.route_width)
+                              route_discount=cfg.route_discount, route_width=cfg.route_width,
+                              slow_radius=self.slow_radius, goal_slack=cfg.goal_slack)
         seconds = time.perf_counter() - t0
         if field is None or cfg.route_discount <= 0.0:
             return field, seconds, None
@@ -275,10 +283,10 @@ class NavigationMemory:
 
     def no_way(self, position: ArrayLike, goal: ArrayLike) -> str:
         """Why the memory holds no way from ``position`` to ``goal`` (x, y) [m] (a query,
-        for goal_unreachable), at the field's hard inflation (``inflation_radius``):
-        the goal within it of a wall, every way closed by the walls themselves, or only
-        by places tried (``avoid``). A goal beyond the window is taken at its edge (said
-        so)."""
+        for goal_unreachable), at the field's hard inflation (``inflation_radius``; the
+        goal moved by up to ``goal_slack``): the goal within it of a wall, every way
+        closed by the walls themselves, or only by places tried (``avoid``). A goal
+        beyond the window is taken at its edge (said so)."""
         g = self.grid
         occ = g.occupied()
         clear = ndimage.distance_transform_edt(~occ) * g.resolution if occ.any() \
@@ -288,8 +296,10 @@ class NavigationMemory:
         beyond = '' if g.inside(cells[1:])[0] else ' (the goal beyond the window, taken ' \
             'at its edge)'
         robot, target = np.clip(cells, 0, np.array(occ.shape) - 1)
-        if not free[tuple(target)]:
-            return f'the goal is within inflation_radius of a wall in the memory{beyond}'
+        target = nearest_free(free, tuple(target), self.cfg.goal_slack / g.resolution)
+        if target is None:
+            return (f'the goal is within inflation_radius of a wall in the memory, with no '
+                    f'free cell within goal_slack{beyond}')
         near = np.zeros_like(free)
         r0, c0 = np.maximum(robot - 3, 0)
         near[r0:robot[0] + 4, c0:robot[1] + 4] = True   # (field.reachable's 3 cells)

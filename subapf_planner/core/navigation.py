@@ -12,7 +12,9 @@ Computed by fast marching (scikit-fmm, Sethian 1996), which solves the eikonal
 equation |grad T| = 1 / speed and is close to Euclidean (8-connected Dijkstra
 overestimates by up to 8 %). Only occupied cells are walls of the field; the
 speed is ``MIN_SPEED`` within ``inflation_radius`` of them (a robot found there is
-led out, not stranded), then rises linearly to 1 at ``inflation_radius +
+led out, not stranded) and, in the memory's fields, within the sampling's clearance
+(``slow_radius``: a gap the local layer will not enter costs as much as contact), then
+rises linearly to 1 at ``inflation_radius +
 clearance_band``: the field keeps to the middle of passages and takes a
 narrow one only when going round costs more. Whether the goal can be reached at
 all is decided on the hard inflation: the free cells at least ``inflation_radius``
@@ -247,8 +249,8 @@ def crop_box(occupied: NDArray[np.bool_], cells: NDArray[np.int64],
 def compute_field(occupied: NDArray[np.bool_], origin: ArrayLike, resolution: float,
                   goal: ArrayLike, robot: ArrayLike, inflation_radius: float,
                   clearance_band: float, coarsening: int = 1, route: ArrayLike | None = None,
-                  route_discount: float = 0.0,
-                  route_width: float = 0.0) -> NavigationField | None:
+                  route_discount: float = 0.0, route_width: float = 0.0,
+                  slow_radius: float = 0.0, goal_slack: float = 0.0) -> NavigationField | None:
     """The navigation field to ``goal`` on an occupancy grid (see the module docstring).
 
     ``coarsening`` > 1 marches on blocks of that many cells a side (fast marching
@@ -262,7 +264,14 @@ def compute_field(occupied: NDArray[np.bool_], origin: ArrayLike, resolution: fl
     docstring) and ``clearance_band`` [m] the band beyond it where travel speeds up.
     ``route`` (k, 2) [m]: the way the robot has taken (the last field's ``path``); travel
     within ``route_width`` [m] of it is ``route_discount`` cheaper (route_speed).
-    Returns None when the goal cell is within ``inflation_radius`` of an occupied cell.
+    ``slow_radius`` [m]: travel closer than this to an occupied cell is as slow as in
+    contact (MIN_SPEED) though not closed: the clearance the local layer keeps from
+    what it sees, so a gap it will not enter costs as much as a wall's face from the
+    start (taken only when no other way is open) and the goal stays reachable.
+    ``goal_slack`` [m]: a goal within ``inflation_radius`` of an occupied cell is
+    replaced by the nearest free cell this close to it (Nav2's planner ``tolerance``:
+    walls drawn through a noisy lidar are some centimetres thicker than the walls).
+    Returns None when no free cell is within ``goal_slack`` of the goal cell.
     """
     origin = np.asarray(origin, float)
     h, w = occupied.shape
@@ -282,14 +291,16 @@ def compute_field(occupied: NDArray[np.bool_], origin: ArrayLike, resolution: fl
     clear = ndimage.distance_transform_edt(~occ) * resolution if occ.any() \
         else np.full(occ.shape, np.inf)
     free = clear >= inflation_radius
-    g_local = (gc[0] - r0, gc[1] - c0)
-    if not free[g_local]:
+    g_local = nearest_free(free, (gc[0] - r0, gc[1] - c0), goal_slack / resolution)
+    if g_local is None:
         return None
+    moved = g_local != (gc[0] - r0, gc[1] - c0)
     labels, _ = ndimage.label(free, structure=np.ones((3, 3)))
     passable = labels == labels[g_local]
     if k > 1:   # (the speed is monotone in the clearance: a block's from its largest)
         occ, clear = _blocks(occ, k, np.logical_or), _blocks(clear, k, np.maximum)
     speed = np.clip((clear - inflation_radius) / max(clearance_band, 1e-9), MIN_SPEED, 1.0)
+    speed[clear < slow_radius] = MIN_SPEED
     patch_origin = origin + np.array([c0, r0]) * resolution
     if route is not None and route_discount > 0.0:
         speed = route_speed(speed, patch_origin, k * resolution, route, route_discount,
@@ -297,15 +308,39 @@ def compute_field(occupied: NDArray[np.bool_], origin: ArrayLike, resolution: fl
     values = _travel_distance(occ, speed, (g_local[0] // k, g_local[1] // k), k * resolution)
     if values is None:
         return None
-    goal_used = g if (0 <= (g - origin)[0] < w * resolution
-                      and 0 <= (g - origin)[1] < h * resolution) \
-        else origin + (gc[::-1] + 0.5) * resolution
+    inside = 0 <= (g - origin)[0] < w * resolution and 0 <= (g - origin)[1] < h * resolution
+    goal_used = g if inside and not moved \
+        else patch_origin + (np.array(g_local[::-1]) + 0.5) * resolution
     field = NavigationField(patch_origin, k * resolution, values, goal_used, passable,
                             resolution)
     if k > 1 and field.reachable(robot) and not np.isfinite(field.value(robot)[0]):
         return compute_field(occupied, origin, resolution, goal, robot, inflation_radius,
-                             clearance_band, 1, route, route_discount, route_width)
+                             clearance_band, 1, route, route_discount, route_width,
+                             slow_radius, goal_slack)
     return field
+
+
+def nearest_free(free: NDArray[np.bool_], cell: tuple[int, int],
+                 radius_cells: float) -> tuple[int, int] | None:
+    """``cell`` (row, col) if it is free, else the free cell of ``free`` nearest it within
+    ``radius_cells`` (cell centres' distance; the first in row order on a tie); None
+    when there is none."""
+    if free[cell]:
+        return cell
+    r = int(math.floor(radius_cells))
+    if r < 1:
+        return None
+    h, w = free.shape
+    r0, r1 = max(cell[0] - r, 0), min(cell[0] + r + 1, h)
+    c0, c1 = max(cell[1] - r, 0), min(cell[1] + r + 1, w)
+    rows, cols = np.nonzero(free[r0:r1, c0:c1])
+    if rows.size == 0:
+        return None
+    d2 = (rows + r0 - cell[0]) ** 2 + (cols + c0 - cell[1]) ** 2
+    k = int(np.argmin(d2))
+    if d2[k] > radius_cells ** 2:
+        return None
+    return int(rows[k] + r0), int(cols[k] + c0)
 
 
 def route_speed(speed: NDArray[np.float64], origin: ArrayLike, cell: float, route: ArrayLike,

@@ -11,7 +11,8 @@ Each tick runs them in this order; the first that decides ends the tick:
 * after it (``after``: may decide from the plan): ``arrival`` (``reached``: the goal
   is done), ``unreachable`` (no way to the goal, or the goal inside an obstacle, for
   ``unreachable_timeout``: given up), ``progress`` (the progress checker: no
-  ``progress_distance`` in ``progress_timeout`` starts a recovery (core/recovery.py),
+  ``progress_distance`` in ``progress_timeout``, or standing with ``no_safe_move`` for
+  ``blocked_timeout``, starts a recovery (core/recovery.py),
   at most ``recoveries`` times a goal, then gives the goal up as stuck; it waits while
   a moving obstacle is within ``giving_way_distance``).
 
@@ -167,25 +168,37 @@ class Progress(Supervisor):
 
     def __init__(self) -> None:
         self._anchor: tuple[np.ndarray, float] | None = None   # where and when it last moved
+        self._blocked_since: float | None = None   # since when it stands with no_safe_move
 
     def restart(self) -> None:
-        self._anchor = None
+        self._anchor = self._blocked_since = None
 
     def after(self, loop: DecisionLoop, result: PlanResult, now: float) -> Decision | None:
-        cmd = result.command
-        if giving_way(result, loop.pose, loop.limits.giving_way_distance):
-            self._anchor = None
+        cmd, lim = result.command, loop.limits
+        if giving_way(result, loop.pose, lim.giving_way_distance):
+            self._anchor = self._blocked_since = None
         if cmd.status.stops and cmd.status is not Status.NO_SAFE_MOVE:
+            self._blocked_since = None
             return None   # stopped for a reason of its own: not the progress checker's
-        self._move_anchor(loop.pose, loop.limits.progress_distance, now)
-        if now - self._anchor[1] <= loop.limits.progress_timeout:
+        self._move_anchor(loop.pose, lim.progress_distance, now)
+        if cmd.status is not Status.NO_SAFE_MOVE:
+            self._blocked_since = None
+        elif self._blocked_since is None:
+            self._blocked_since = now
+        blocked = self._blocked_since is not None and now - self._blocked_since > \
+            lim.blocked_timeout
+        late = now - self._anchor[1] > lim.progress_timeout
+        if not (late or blocked):
             return None
         command = (0.0, 0.0) if cmd.status.stops else (cmd.v, cmd.w)   # (standing at a gap)
         if loop.recoveries.attempt(loop, now):
-            self._anchor = None
+            self._anchor = self._blocked_since = None
             tried, most = loop.recoveries.tried, loop.limits.recoveries
-            return loop.decide(command, State.DRIVING, f'no progress: the way ahead marked '
+            why = 'no progress' if late else 'no safe move'
+            return loop.decide(command, State.DRIVING, f'{why}: the way ahead marked '
                                f'tried ({tried} of {most}), another way', result)
+        if not late:
+            return None   # no recovery left: given up only on the progress checker's clock
         return loop.stop(State.STUCK, 'no progress, goal abandoned', result)
 
     def _move_anchor(self, pose: np.ndarray, distance: float, now: float) -> None:
