@@ -97,6 +97,7 @@ class NavigationMemory:
         self.compute_seconds = 0.0
         self._distance: DistanceField | None = None   # the alignment's, and its age
         self._distance_age = 0
+        self._hard_free_cache: tuple | None = None   # no_way's free cells, per map state
         #: Places tried and not passed: (x, y, radius [m], until [s]) (see ``avoid``).
         self.avoided: list[tuple[float, float, float, float]] = []
         #: A field to march between cycles (start_marching starts it) ...
@@ -125,6 +126,7 @@ class NavigationMemory:
         self.field, self._field_key, self._field_time = None, None, -math.inf
         self._scan_stamp = None
         self._distance, self._distance_age = None, 0
+        self._hard_free_cache = None
         self.avoided = []
         self.route, self._route_goal = None, None
         self._drop_pending()
@@ -288,14 +290,11 @@ class NavigationMemory:
         closed by the walls themselves, or only by places tried (``avoid``). A goal
         beyond the window is taken at its edge (said so)."""
         g = self.grid
-        occ = g.occupied()
-        clear = ndimage.distance_transform_edt(~occ) * g.resolution if occ.any() \
-            else np.full(occ.shape, np.inf)
-        free = clear >= self.cfg.inflation_radius
+        free, labels = self._hard_free()
         cells = g.cell_of(np.array([position, goal], float).reshape(2, 2))
         beyond = '' if g.inside(cells[1:])[0] else ' (the goal beyond the window, taken ' \
             'at its edge)'
-        robot, target = np.clip(cells, 0, np.array(occ.shape) - 1)
+        robot, target = np.clip(cells, 0, np.array(free.shape) - 1)
         target = nearest_free(free, tuple(target), self.cfg.goal_slack / g.resolution)
         if target is None:
             return (f'the goal is within inflation_radius of a wall in the memory, with no '
@@ -303,12 +302,26 @@ class NavigationMemory:
         near = np.zeros_like(free)
         r0, c0 = np.maximum(robot - 3, 0)
         near[r0:robot[0] + 4, c0:robot[1] + 4] = True   # (field.reachable's 3 cells)
-        labels, _ = ndimage.label(free, structure=np.ones((3, 3)))
         if not np.isin(labels[free & near], labels[tuple(target)]).any():
             return f'the walls in the memory close every way{beyond}'
         if self.avoided:
             return f'every way through the walls tried{beyond}'
         return f"no way at the field's resolution{beyond}"
+
+    def _hard_free(self) -> tuple[NDArray[np.bool_], NDArray[np.int32]]:
+        """The cells at least ``inflation_radius`` from every occupied cell and their
+        8-connected labels, made once for each state of the map (no_way is asked every
+        cycle the goal is unreachable)."""
+        g = self.grid
+        key = (g.version, *g.origin, self.cfg.inflation_radius)
+        if self._hard_free_cache is None or self._hard_free_cache[0] != key:
+            occ = g.occupied()
+            clear = ndimage.distance_transform_edt(~occ) * g.resolution if occ.any() \
+                else np.full(occ.shape, np.inf)
+            free = clear >= self.cfg.inflation_radius
+            labels, _ = ndimage.label(free, structure=np.ones((3, 3)))
+            self._hard_free_cache = (key, free, labels)
+        return self._hard_free_cache[1], self._hard_free_cache[2]
 
     def clear(self, points: ArrayLike) -> None:
         """Cells under ``points`` (n, 2) [m] that are occupied become unknown: something
