@@ -244,13 +244,16 @@ def test_the_pose_error_and_the_ghosts_are_reported_where_recorded():
 @core
 def test_time_and_path_against_the_shortest_are_reported_where_recorded():
     """The speed table: per method, over its runs that reached, the time over the
-    physical limit and the path over the shortest path (median, p90); nothing for files
-    from before the bench recorded them."""
-    timed = [dict(r, time_over_limit=t, path_over_shortest=p)
-             for r, t, p in zip(RUNS[:3], (1.0, 1.2, 2.0), (1.0, 1.1, 1.5), strict=True)]
-    rs = results.load_runset_doc(bench_doc(timed + RUNS[3:]), 'x.json')
+    physical limit and the path over the shortest path (median, p90), and over its runs
+    with a shortest path the BARN score's mean; nothing for files from before the bench
+    recorded them."""
+    timed = [dict(r, time_over_limit=t, path_over_shortest=p, shortest_path=5.0)
+             for r, t, p in zip(RUNS[:3], (1.0, 1.2, 4.0), (1.0, 1.1, 1.5), strict=True)]
+    failed = [dict(r, shortest_path=5.0) for r in RUNS[3:5]]   # collision, missed: 0
+    rs = results.load_runset_doc(bench_doc(timed + failed + RUNS[5:]), 'x.json')
     cells = row(results.speed_table(rs), 'a:geodesic')
-    assert cells[1:] == ['3', '1.20', '1.84', '1.10', '1.42']   # p90 interpolated
+    # p90 interpolated; BARN score (0.5 + 0.5 + 1 / 4 + 0 + 0) / 5
+    assert cells[1:] == ['3', '1.20', '3.44', '1.10', '1.42', '0.250']
     assert results.speed_table(results.load_runset_doc(bench_doc(RUNS), 'y.json')) == ''
 
 
@@ -279,3 +282,21 @@ def test_the_shortest_path_comes_from_the_suites_index_or_the_geodesic(tmp_path)
     missed = efficiency(dict(record, outcome='missed'), 7.25, 0.22)
     assert missed['time_over_limit'] is None and missed['path_over_shortest'] is None
     assert efficiency(record, math.inf, 0.22)['shortest_path'] is None
+    assert e['barn_score'] == pytest.approx(0.5) and missed['barn_score'] == 0.0
+
+
+@core
+def test_the_barn_score_is_the_challenges():
+    """tools/metrics.barn_score: success x optimal time / clip(actual, 2 x optimal,
+    8 x optimal), as the BARN Challenge's run.py computes it (optimal: the path at the
+    robot's top speed). A 10 m path at 2 m/s: optimal 5 s."""
+    from subapf_planner.tools.metrics import barn_score
+
+    def score(actual, success=True):
+        optimal = 10.0 / 2.0
+        return barn_score(success, actual / optimal)
+    assert score(8.0) == pytest.approx(5.0 / 10.0)      # faster than 2x optimal: 0.5
+    assert score(20.0) == pytest.approx(5.0 / 20.0)
+    assert score(50.0) == pytest.approx(5.0 / 40.0)     # slower than 8x optimal: 1/8
+    assert score(20.0, success=False) == 0.0
+    assert barn_score(True, None) == 0.0

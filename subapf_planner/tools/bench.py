@@ -43,7 +43,9 @@ from ..sim.simulator import SimConfig
 from ..sim.solvability import geodesic_length
 from ..sim.world import World, WorldError, load_world, world_files
 from .animation import animate_run
+from .metrics import barn_score
 from .plots import plot_trajectories
+from .results import RunSet, perception_table, speed_table
 
 #: The default comparison: the package's default, the paper's method and its ablations
 #: (Euclidean attraction, eq. 21), and the DWA baseline, classic and on the same field
@@ -97,13 +99,15 @@ def efficiency(record: dict, shortest: float, top_speed: float) -> dict:
     """The run's record with its world's ``shortest_path`` [m] and, when it reached,
     ``time_over_limit`` (its time over the physical limit: the shortest path at the
     robot's top speed) and ``path_over_shortest`` (its path over the shortest); None
-    where they do not apply."""
+    where they do not apply; and ``barn_score`` (:func:`barn_score`; None without a
+    shortest path)."""
     known = math.isfinite(shortest) and shortest > 0.0 and top_speed > 0.0
     ok = known and record['outcome'] == 'reached'
+    over = round(record['time_s'] * top_speed / shortest, 3) if ok else None
     return {**record, 'shortest_path': round(shortest, 3) if known else None,
-            'time_over_limit': round(record['time_s'] * top_speed / shortest, 3)
-            if ok else None,
-            'path_over_shortest': round(record['path_length'] / shortest, 3) if ok else None}
+            'time_over_limit': over,
+            'path_over_shortest': round(record['path_length'] / shortest, 3) if ok else None,
+            'barn_score': round(barn_score(ok, over), 4) if known else None}
 
 
 def parse_method(spec: str) -> dict:
@@ -234,52 +238,11 @@ def by_family(runs: list[dict], methods: list[str]) -> str:
     return '\n'.join(lines) + '\n'
 
 
-def _percentile(values: list[float], q: float) -> float:
-    return float(np.percentile(values, q)) if values else math.nan
-
-
-def perception(runs: list[dict], methods: list[str]) -> str:
-    """Per method: the planned-from pose's error against the truth when the planner
-    stopped at the goal (median, p95, max) and at worst in a run (median, max); cycles
-    spent evading in worlds where nothing moves (all, share of their cycles, the most in
-    one run)."""
-    lines = ['| method | pose error at arrival [m] median / p95 / max | worst pose error '
-             'in a run [m] median / max | evading cycles in static worlds (share, most in '
-             'a run) |', '|---|---|---|---|']
-    for m in methods:
-        rs = [r for r in runs if r['method'] == m]
-        final = [r['pose_error_final'] for r in rs
-                 if r['outcome'] in ('reached', 'missed') and r.get('pose_error_final')
-                 is not None]
-        worst = [r['pose_error_max'] for r in rs if r.get('pose_error_max') is not None]
-        static = [r for r in rs if not r.get('moving_world', False)]
-        evading = [r.get('evading_cycles', 0) for r in static]
-        cycles = sum(r['cycles'] for r in static)
-        lines.append(
-            f'| {m} | {_percentile(final, 50):.3f} / {_percentile(final, 95):.3f} / '
-            f'{max(final, default=math.nan):.3f} | {_percentile(worst, 50):.3f} / '
-            f'{max(worst, default=math.nan):.3f} | {sum(evading)} '
-            f'({sum(evading) / max(cycles, 1):.2%}, {max(evading, default=0)}) |')
-    return '\n'.join(lines) + '\n'
-
-
-def speed(runs: list[dict], methods: list[str]) -> str:
-    """Per method, over the runs that reached: time over the physical limit and path
-    over the shortest path (median, p90); '' when no run records them."""
-    lines = []
-    for m in methods:
-        ok = [r for r in runs if r['method'] == m and r.get('time_over_limit') is not None]
-        if not ok:
-            continue
-        t = [r['time_over_limit'] for r in ok]
-        p = [r['path_over_shortest'] for r in ok]
-        lines.append(f'| {m} | {len(ok)} | {_percentile(t, 50):.2f} / {_percentile(t, 90):.2f} '
-                     f'| {_percentile(p, 50):.2f} / {_percentile(p, 90):.2f} |')
-    if not lines:
-        return ''
-    return '\n'.join(['| method | reached | time over the physical limit, median / p90 '
-                      '| path over the shortest, median / p90 |', '|---|---|---|---|',
-                      *lines]) + '\n'
+def _tables(runs: list[dict], methods: list[str]) -> str:
+    """The pose error and evading table and the time, path and BARN score table, as
+    docs/results.md has them (tools/results.py)."""
+    rs = RunSet(name='', runs=runs, methods=methods)
+    return ''.join(t + '\n' for t in (perception_table(rs), speed_table(rs)) if t)
 
 
 def summarise(runs: list[dict], methods: list[str]) -> str:
@@ -462,8 +425,7 @@ def main(argv: list[str] | None = None) -> int:
            'params': dataclasses.asdict(cfg)}
     (out / 'results.json').write_text(json.dumps(doc, indent=1))
     (out / 'summary.md').write_text(summarise(runs, labels) + '\n' + by_family(runs, labels)
-                                    + '\n' + perception(runs, labels)
-                                    + '\n' + speed(runs, labels)
+                                    + '\n' + _tables(runs, labels)
                                     + '\n' + given_up(runs)
                                     + '\n' + paired(runs, labels)
                                     + f'\n{len(runs)} runs in {wall:.1f} s wall time.\n')

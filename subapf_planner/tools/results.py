@@ -27,6 +27,8 @@ import sys
 import numpy as np
 import yaml
 
+from .metrics import barn_score
+
 PROG = 'subapf-results'
 DATA = Path('docs/results/data')
 OUT = Path('docs/results.md')
@@ -234,8 +236,10 @@ def perception_table(rs: RunSet) -> str:
 
 def speed_table(rs: RunSet) -> str:
     """Per method, over its runs that reached: time over the physical limit (the shortest
-    path at the robot's top speed) and path over the shortest path, median and p90; ''
-    when no run records them (results files from before the bench did)."""
+    path at the robot's top speed) and path over the shortest path, median and p90; and
+    over all its runs with a shortest path, the BARN Challenge's score (tools/metrics.py,
+    mean; 0.5 at most); '' when no run records them (results files from before the
+    bench did)."""
     lines = []
     for m in rs.methods:
         ok = [r for r in rs.runs if r['method'] == m and r.get('time_over_limit') is not None]
@@ -243,12 +247,16 @@ def speed_table(rs: RunSet) -> str:
             continue
         t = [r['time_over_limit'] for r in ok]
         p = [r['path_over_shortest'] for r in ok]
+        scored = [barn_score(r['outcome'] == 'reached', r.get('time_over_limit'))
+                  for r in rs.runs if r['method'] == m and r.get('shortest_path') is not None]
         lines.append(f'| `{m}` | {len(ok)} | {_num(_median(t), 2)} | {_num(_p90(t), 2)} '
-                     f'| {_num(_median(p), 2)} | {_num(_p90(p), 2)} |')
+                     f'| {_num(_median(p), 2)} | {_num(_p90(p), 2)} '
+                     f'| {_num(float(np.mean(scored)) if scored else None, 3)} |')
     if not lines:
         return ''
     return '\n'.join(['| method | reached | time over the physical limit, median | p90 '
-                      '| path over the shortest, median | p90 |', '|' + '---|' * 6, *lines])
+                      '| path over the shortest, median | p90 | BARN score, mean |',
+                      '|' + '---|' * 7, *lines])
 
 
 def worlds_table(rs: RunSet) -> str:
