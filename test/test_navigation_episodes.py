@@ -81,27 +81,44 @@ def test_a_gap_of_twice_robot_radius_plus_5_cm_is_passed(offset):
     assert run_episode(world, PAPER, IDEAL).outcome is not Outcome.REACHED
 
 
+def narrow_gap_world(gap: float, end: float = 5.5):
+    """A wall across the way with a gap straight ahead and an open end 5.5 m to the side
+    (the way round 8 m longer)."""
+    return parse_world({'name': 'narrow', 'start': [0.0, 0.0, 1.5708], 'goal': [0.0, 3.0],
+                        'time_limit': 200, 'bounds': [-2.5, -1.0, end + 2.5, 4.0],
+                        'obstacles': [{'box': {'center': [(-gap / 2 - 2.5) / 2, 1.5],
+                                               'size': [2.5 - gap / 2, 0.1]}},
+                                      {'box': {'center': [(gap / 2 + end) / 2, 1.5],
+                                               'size': [end - gap / 2, 0.1]}}]})
+
+
+def test_a_gap_it_cannot_pass_is_tried_for_seconds_then_the_other_way_taken():
+    """A 0.25 m gap straight ahead: the field (inflated by the footprint, 0.21 m) leads
+    through it; the local layer (samples kept 0.135 m from laser points) cannot pass and
+    the robot stands with no_safe_move. After blocked_timeout (3 s) of it, not
+    progress_timeout, the gap is marked tried and the goal reached round the wall's
+    end, with one recovery. Exact rays (with noise the memory's wall ends close the gap
+    and the field leads round at once)."""
+    result = run_episode(narrow_gap_world(0.25), EXACT_CFG.replace(field_worker=False), EXACT,
+                         limits=Supervision(recoveries=1))
+    assert result.outcome is Outcome.REACHED
+    assert 0 < result.statuses.get('no_safe_move', 0) <= 5 * 4   # 5 Hz: at most ~4 s
+    assert result.path[:, 0].max() > 5.5                          # round the wall's end
+
+
 @pytest.mark.parametrize('gap', [0.22, 0.25])
-def test_a_gap_narrower_than_footprint_plus_clearance_is_not_entered(gap):
-    """A gap straight ahead wider than the footprint (0.21 m) but narrower than the
-    local layer's clearance either side (2 x 0.135 m): the field is as slow there as
-    along a wall's face (NavigationMemory.slow_radius), so it leads round the wall's
-    open end, 8 m longer, from the start; the robot neither stands at the gap with
-    no_safe_move nor needs a recovery (none allowed). Exact rays, so that the memory's
-    wall ends leave the gap open (with noise they close it anyway)."""
-    end = 5.5
-    doc = {'name': 'narrow', 'start': [0.0, 0.0, 1.5708], 'goal': [0.0, 3.0],
-           'time_limit': 200, 'bounds': [-2.5, -1.0, end + 2.5, 4.0],
-           'obstacles': [{'box': {'center': [(-gap / 2 - 2.5) / 2, 1.5],
-                                  'size': [2.5 - gap / 2, 0.1]}},
-                         {'box': {'center': [(gap / 2 + end) / 2, 1.5],
-                                  'size': [end - gap / 2, 0.1]}}]}
-    world = parse_world(doc)
-    for cfg in (EXACT_CFG, EXACT_CFG.replace(field_worker=False)):
-        result = run_episode(world, cfg, EXACT, limits=Supervision(recoveries=0))
+def test_with_gap_clearance_a_gap_narrower_than_footprint_plus_clearance_is_not_entered(gap):
+    """The same wall, the gap wider than the footprint (0.21 m) but narrower than the
+    local layer's clearance either side (2 x 0.135 m), and gap_clearance 0.16 m (the
+    sampling's clearance plus half a cell): the field is as slow in the gap as along a
+    wall's face, so it leads round the wall's open end from the start; the robot
+    neither stands at the gap nor needs a recovery (none allowed)."""
+    cfg = EXACT_CFG.replace(gap_clearance=0.16)
+    for c in (cfg, cfg.replace(field_worker=False)):
+        result = run_episode(narrow_gap_world(gap), c, EXACT, limits=Supervision(recoveries=0))
         assert result.outcome is Outcome.REACHED
         assert result.statuses.get('no_safe_move', 0) == 0
-        assert result.path[:, 0].max() > end            # round the wall's end
+        assert result.path[:, 0].max() > 5.5            # round the wall's end
         below = result.path[result.path[:, 1] < 1.5]     # before passing the wall
         assert np.hypot(below[:, 0], below[:, 1] - 1.5).min() > 0.5   # not at the gap
 

@@ -137,6 +137,14 @@ class PlannerConfig:
                                     'slower; a goal there is unreachable, and so is one that '
                                     'only gaps narrower than twice this lead to)', 'm',
                                     0.0, 2.0)
+    gap_clearance: float = param(0.0, 'Field: travel closer than this to a wall in the '
+                                 'memory is as slow as contact, so a gap narrower than '
+                                 'twice this is taken only when no other way is open '
+                                 '(sample_clearance plus half a cell, 0.16, makes the field '
+                                 'agree with the sampling); 0, the default: only within '
+                                 'inflation_radius (measured: through a noisy lidar the '
+                                 "memory's walls are thicker than the walls and it closed "
+                                 'real gaps; docs/memory.md)', 'm', 0.0, 2.0)
     goal_slack: float = param(0.075, 'Field: a goal within inflation_radius of a wall in the '
                               'memory is replaced by the nearest free cell this close to it '
                               "(Nav2's planner tolerance: walls drawn through a noisy lidar "

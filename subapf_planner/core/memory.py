@@ -167,13 +167,6 @@ class NavigationMemory:
         self._due = FieldJob(self._blocked(now), self.grid.origin.copy(), goal, position,
                              key, now, self._route_for(key))
 
-    @property
-    def slow_radius(self) -> float:
-        """Where the field is as slow as in contact [m] (compute_field): the sampling's
-        clearance from the laser's points, plus half a cell (a wall's surface lies
-        anywhere in its cell, the distances are from the cells' centres)."""
-        return self.cfg.discard_distance + 0.5 * self.grid.resolution
-
     def _compute(self, blocked: NDArray[np.bool_], origin: NDArray, goal: NDArray,
                  position: NDArray, route: NDArray | None
                  ) -> tuple[NavigationField | None, float, NDArray | None]:
@@ -186,7 +179,7 @@ class NavigationMemory:
                               clearance_band=cfg.inflation_band,
                               coarsening=cfg.field_coarsening, route=route,
                               route_discount=cfg.route_discount, route_width=cfg.route_width,
-                              slow_radius=self.slow_radius, goal_slack=cfg.goal_slack)
+                              slow_radius=cfg.gap_clearance, goal_slack=cfg.goal_slack)
         seconds = time.perf_counter() - t0
         if field is None or cfg.route_discount <= 0.0:
             return field, seconds, None

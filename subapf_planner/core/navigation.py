@@ -12,9 +12,9 @@ Computed by fast marching (scikit-fmm, Sethian 1996), which solves the eikonal
 equation |grad T| = 1 / speed and is close to Euclidean (8-connected Dijkstra
 overestimates by up to 8 %). Only occupied cells are walls of the field; the
 speed is ``MIN_SPEED`` within ``inflation_radius`` of them (a robot found there is
-led out, not stranded) and, in the memory's fields, within the sampling's clearance
-(``slow_radius``: a gap the local layer will not enter costs as much as contact), then
-rises linearly to 1 at ``inflation_radius +
+led out, not stranded; and, when asked, within ``slow_radius``: the sampling's
+clearance, so that a gap the local layer will not enter costs as much as contact),
+then rises linearly to 1 at ``inflation_radius +
 clearance_band``: the field keeps to the middle of passages and takes a
 narrow one only when going round costs more. Whether the goal can be reached at
 all is decided on the hard inflation: the free cells at least ``inflation_radius``
