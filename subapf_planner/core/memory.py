@@ -179,7 +179,7 @@ class NavigationMemory:
                               clearance_band=cfg.inflation_band,
                               coarsening=cfg.field_coarsening, route=route,
                               route_discount=cfg.route_discount, route_width=cfg.route_width,
-                              slow_radius=cfg.gap_clearance, goal_slack=cfg.goal_slack)
+                              gap_clearance=cfg.gap_clearance, goal_slack=cfg.goal_slack)
         seconds = time.perf_counter() - t0
         if field is None or cfg.route_discount <= 0.0:
             return field, seconds, None

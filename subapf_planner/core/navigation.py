@@ -12,7 +12,7 @@ Computed by fast marching (scikit-fmm, Sethian 1996), which solves the eikonal
 equation |grad T| = 1 / speed and is close to Euclidean (8-connected Dijkstra
 overestimates by up to 8 %). Only occupied cells are walls of the field; the
 speed is ``MIN_SPEED`` within ``inflation_radius`` of them (a robot found there is
-led out, not stranded; and, when asked, within ``slow_radius``: the sampling's
+led out, not stranded; and, when asked, within ``gap_clearance``: the sampling's
 clearance, so that a gap the local layer will not enter costs as much as contact),
 then rises linearly to 1 at ``inflation_radius +
 clearance_band``: the field keeps to the middle of passages and takes a
@@ -250,7 +250,7 @@ def compute_field(occupied: NDArray[np.bool_], origin: ArrayLike, resolution: fl
                   goal: ArrayLike, robot: ArrayLike, inflation_radius: float,
                   clearance_band: float, coarsening: int = 1, route: ArrayLike | None = None,
                   route_discount: float = 0.0, route_width: float = 0.0,
-                  slow_radius: float = 0.0, goal_slack: float = 0.0) -> NavigationField | None:
+                  gap_clearance: float = 0.0, goal_slack: float = 0.0) -> NavigationField | None:
     """The navigation field to ``goal`` on an occupancy grid (see the module docstring).
 
     ``coarsening`` > 1 marches on blocks of that many cells a side (fast marching
@@ -264,7 +264,7 @@ def compute_field(occupied: NDArray[np.bool_], origin: ArrayLike, resolution: fl
     docstring) and ``clearance_band`` [m] the band beyond it where travel speeds up.
     ``route`` (k, 2) [m]: the way the robot has taken (the last field's ``path``); travel
     within ``route_width`` [m] of it is ``route_discount`` cheaper (route_speed).
-    ``slow_radius`` [m]: travel closer than this to an occupied cell is as slow as in
+    ``gap_clearance`` [m]: travel closer than this to an occupied cell is as slow as in
     contact (MIN_SPEED) though not closed: the clearance the local layer keeps from
     what it sees, so a gap it will not enter costs as much as a wall's face from the
     start (taken only when no other way is open) and the goal stays reachable.
@@ -300,7 +300,7 @@ def compute_field(occupied: NDArray[np.bool_], origin: ArrayLike, resolution: fl
     if k > 1:   # (the speed is monotone in the clearance: a block's from its largest)
         occ, clear = _blocks(occ, k, np.logical_or), _blocks(clear, k, np.maximum)
     speed = np.clip((clear - inflation_radius) / max(clearance_band, 1e-9), MIN_SPEED, 1.0)
-    speed[clear < slow_radius] = MIN_SPEED
+    speed[clear < gap_clearance] = MIN_SPEED
     patch_origin = origin + np.array([c0, r0]) * resolution
     if route is not None and route_discount > 0.0:
         speed = route_speed(speed, patch_origin, k * resolution, route, route_discount,
@@ -316,7 +316,7 @@ def compute_field(occupied: NDArray[np.bool_], origin: ArrayLike, resolution: fl
     if k > 1 and field.reachable(robot) and not np.isfinite(field.value(robot)[0]):
         return compute_field(occupied, origin, resolution, goal, robot, inflation_radius,
                              clearance_band, 1, route, route_discount, route_width,
-                             slow_radius, goal_slack)
+                             gap_clearance, goal_slack)
     return field
 
 
