@@ -258,7 +258,7 @@ def test_planner_stops_for_an_enclosed_goal_and_drives_when_it_opens():
 
 @pytest.mark.parametrize('coarsening', [1, 2])
 def test_a_goal_a_few_centimetres_inside_the_inflation_is_led_to_beside_it(coarsening):
-    """A wall along y = 1 m (cells 20-21), the goal 0.125 m from its cells' centres,
+    """A wall along y = 1 m (cells 20-21), the goal 0.115 m from its cells' centres,
     inside an inflation of 0.15 m: with goal_slack the field leads to the nearest free
     cell (0.035 m farther out), as the memory's walls are drawn some centimetres thick;
     without it, or with the goal on the wall, there is no field."""
