@@ -11,6 +11,7 @@ PACKAGE = 'subapf_planner'
 # (module:function, ros2 run name, plain command name)
 EXECUTABLES = [
     ('ros.planner_node:main', 'planner_node', 'subapf-planner'),
+    ('ros.lifecycle_node:main', 'lifecycle_planner_node', 'subapf-planner-lifecycle'),
     ('ros.sim_node:main', 'sim_node', 'subapf-sim'),
     ('ros.foxglove_node:main', 'foxglove_node', 'subapf-foxglove'),
     ('tools.bringup:main', 'bringup', 'subapf-bringup'),

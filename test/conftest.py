@@ -172,17 +172,30 @@ def pytest_collection_modifyitems(config, items):
     warnings.warn(pytest.PytestWarning(message), stacklevel=1)
 
 
-@pytest.fixture(scope='session')
-def tf2_msgs_built() -> dict[str, str]:
-    """PYTHONPATH, LD_LIBRARY_PATH and AMENT_PREFIX_PATH for a process to import
-    tf2_msgs and find its .msg: the ROS install's (none needed) when there is one, else
-    the package test/tf_build.py builds once."""
+def _interfaces(name: str, probe: str) -> dict[str, str]:
+    """PYTHONPATH, LD_LIBRARY_PATH and AMENT_PREFIX_PATH for a process to import the
+    interface package ``name`` and find its definitions: the ROS install's (none needed)
+    when there is one (``probe`` imports), else the package test/interfaces_build.py
+    builds once."""
     try:
-        from tf2_msgs.msg import TFMessage  # noqa: F401
+        __import__(probe)
         return {}
     except ImportError:
-        from tf_build import tf2_msgs_paths
-        return tf2_msgs_paths()
+        from interfaces_build import interface_paths
+        return interface_paths(name)
+
+
+@pytest.fixture(scope='session')
+def tf2_msgs_built() -> dict[str, str]:
+    """What a process needs to import tf2_msgs (_interfaces)."""
+    return _interfaces('tf2_msgs', 'tf2_msgs.msg')
+
+
+@pytest.fixture(scope='session')
+def nav2_msgs_built() -> dict[str, str]:
+    """What a process needs to import nav2_msgs' NavigateToPose and FollowPath
+    (_interfaces)."""
+    return _interfaces('nav2_msgs', 'nav2_msgs.action')
 
 
 def with_paths(env: dict[str, str], paths: dict[str, str]) -> dict[str, str]:

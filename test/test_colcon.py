@@ -70,8 +70,8 @@ def test_colcon_build_installs_ros2_run_executables(tmp_path):
     assert (share / 'config' / 'subapf.rviz').is_file()
     assert len(list((share / 'worlds').glob('*.yaml'))) >= 8
     # what `ros2 launch subapf_planner <file>` and the robot configs need
-    assert {p.name for p in (share / 'launch').iterdir()} == {'planner.launch.py',
-                                                              'sim.launch.py'}
+    assert {p.name for p in (share / 'launch').iterdir()} == {
+        'planner.launch.py', 'sim.launch.py', 'nav2.launch.py'}
     assert {p.name for p in (share / 'config' / 'robots').iterdir()} == {
         'burger.yaml', 'waffle_pi.yaml', 'turtlebot4.yaml'}
     # an installed executable runs (figures needs no ROS graph), from its entry point

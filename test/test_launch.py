@@ -21,6 +21,7 @@ LAUNCH = REPO / 'launch'
 SHARE = {'config': REPO / 'config', 'worlds': REPO / 'sim' / 'worlds', 'launch': LAUNCH}
 PARAMETERS = {
     'planner_node': {f.name for g in PLANNER_GROUPS for f in dataclasses.fields(g)},
+    'lifecycle_planner_node': {f.name for g in PLANNER_GROUPS for f in dataclasses.fields(g)},
     'sim_node': {f.name for g in SIM_GROUPS for f in dataclasses.fields(g)},
     'foxglove_node': {f.name for f in dataclasses.fields(FoxgloveOptions)},
 }
@@ -67,8 +68,8 @@ def launch_file(request):
 
 
 def test_both_launch_files_ship():
-    assert {p.name for p in LAUNCH.glob('*.launch.py')} == {'planner.launch.py',
-                                                           'sim.launch.py'}
+    assert {p.name for p in LAUNCH.glob('*.launch.py')} == {
+        'planner.launch.py', 'sim.launch.py', 'nav2.launch.py'}
 
 
 def test_a_launch_file_defines_its_description(launch_file):
@@ -77,11 +78,24 @@ def test_a_launch_file_defines_its_description(launch_file):
                for n in tree.body)
 
 
+#: Nodes of Nav2 a launch file may start: (package, executable) -> the parameters it
+#: may set (nav2_lifecycle_manager's, as docs.nav2.org lists them for Jazzy).
+NAV2 = {('nav2_lifecycle_manager', 'lifecycle_manager'): {
+    'autostart', 'node_names', 'bond_timeout', 'bond_heartbeat_period',
+    'attempt_respawn_reconnection', 'bond_respawn_max_duration', 'service_timeout'}}
+
+
 def test_nodes_name_existing_executables_and_parameters(launch_file):
     _, tree = launch_file
     for node in calls(tree, 'Node'):
-        assert constant(tree, keyword(node, 'package')) == 'subapf_planner'
+        package = constant(tree, keyword(node, 'package'))
         exe = constant(tree, keyword(node, 'executable'))
+        if package != 'subapf_planner':
+            assert (package, exe) in NAV2, (package, exe)
+            for item in keyword(node, 'parameters').elts:
+                names = {ast.literal_eval(k) for k in item.keys}
+                assert names <= NAV2[package, exe] | {'use_sim_time'}, names
+            continue
         assert exe in BARE, exe
         for item in keyword(node, 'parameters').elts:
             if isinstance(item, ast.Dict):   # parameters set in the file

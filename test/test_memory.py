@@ -10,7 +10,7 @@ import pytest
 
 from subapf_planner.core.config import PlannerConfig
 from subapf_planner.core.memory import NavigationMemory
-from subapf_planner.core.navigation import NEIGHBOURS, compute_field, thin_polyline
+from subapf_planner.core.navigation import NEIGHBOURS, compute_field, densify, thin_polyline
 from subapf_planner.core.occupancy import LOG_ODDS_MAX, OccupancyGrid
 from subapf_planner.core.planner import Planner
 from subapf_planner.core.scan import Scan
@@ -227,6 +227,39 @@ def test_the_route_taken_is_kept_until_another_way_is_clearly_shorter():
         mem.field_for((0.0, 0.0), (2.0, 0.0), -math.inf)
         assert bool(mem.route is not None
                     and np.hypot(*(mem.route[-1] - (2.0, 0.0))) < 0.1) is kept
+
+
+def test_a_path_given_to_follow_is_descended_and_left_where_the_memory_blocks_it():
+    """NavigationMemory.follow (the follow_path action): in open space the field leads
+    along a given path 25 % longer than the straight way (path_discount 0.5: within
+    path_width and a cell of it), not
+    straight; where the scan shows the path blocked it leads round and still to the goal
+    (one minimum); without a path, straight again."""
+    start, goal = (0.0, 0.0), (4.0, 0.0)
+    bend = np.array([[0.0, 0.0], [2.0, 1.5], [4.0, 0.0]])   # 5 m against 4 m
+
+    def off_path(descent):
+        d = np.hypot(*(descent[:, None, :] - densify(bend, 0.01)[None]).transpose(2, 0, 1))
+        return d.min(axis=1).max()
+    mem = NavigationMemory(PlannerConfig(field_worker=False))
+    straight = mem.field_for(start, goal, -math.inf)[0].path(start)
+    assert np.abs(straight[:, 1]).max() < 0.15
+    mem.follow(bend)
+    along = mem.field_for(start, goal, -math.inf)[0].path(start)
+    assert off_path(along) < 0.3 and np.hypot(*(along[-1] - goal)) < 0.1
+    # a wall seen across the bend: the descent leaves the path there and reaches the goal
+    ranges, amin, inc, rmin, rmax = enclosure_scan(1.0)
+    ranges = np.full_like(ranges, np.inf)
+    bearing = np.arange(len(ranges)) * inc + amin
+    ranges[np.abs(bearing - math.atan2(1.5, 2.0)) < 0.12] = 2.4   # a wall 0.6 m wide
+    mem.integrate(Scan(ranges, amin, inc, rmin, rmax, 0.0), (0.0, 0.0, 0.0))
+    field = mem.field_for(start, goal, -math.inf)[0]
+    around = field.path(start)
+    assert field.reachable(start) and np.hypot(*(around[-1] - goal)) < 0.1
+    assert off_path(around) > 0.4
+    mem.follow(None)
+    again = mem.field_for(start, goal, -math.inf)[0].path(start)
+    assert np.abs(again[:, 1]).max() < 0.15
 
 
 def test_goal_in_an_inflated_obstacle_has_no_field():

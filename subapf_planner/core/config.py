@@ -164,6 +164,14 @@ class PlannerConfig:
                                   0.0, 0.9)
     route_width: float = param(0.3, 'Field: half-width of the route route_discount favours',
                                'm', 0.0, 2.0)
+    path_discount: float = param(0.5, 'Field: travel along a path given to follow (the '
+                                 "follow_path action: a global planner's path, path_width "
+                                 'either side) costs this fraction less, so the robot keeps '
+                                 'to it and leaves it where the scan shows it blocked or a '
+                                 'way off it is that much shorter (docs/nav2.md)', '',
+                                 0.0, 0.9)
+    path_width: float = param(0.2, 'Field: half-width of the path path_discount favours',
+                              'm', 0.0, 2.0)
     field_period: float = param(1.0, 'Shortest time between two field computations (sooner '
                                 'for a new goal, or when the robot leaves the patch)', 's',
                                 0.0, 60.0)

@@ -26,11 +26,12 @@ import numpy as np
 
 from .config import PlannerConfig
 from .cycle import PlanResult
+from .known_map import KnownMap
 from .memory import SAME_GOAL
 from .occupancy import OccupancyGrid
 from .params import check_fields, param
 from .planner import Planner
-from .robot import compose, invert
+from .robot import compose, invert, to_parent
 from .scan import GRAZING_MEMORY, GRAZING_OBSTACLES, Scan, denoise_each, deskew
 from .status import State, Status
 from .supervisors import SUPERVISORS, Recoveries
@@ -175,21 +176,27 @@ class DecisionLoop:
         """The state as ``~/status`` carries it: ``"state: reason"``."""
         return f'{self.state}: {self.reason}'
 
-    def set_goal(self, goal: np.ndarray, in_map: bool = False) -> bool:
+    def set_goal(self, goal: np.ndarray, in_map: bool = False,
+                 path: np.ndarray | None = None) -> bool:
         """A new goal resets the planner; the goal being driven to (or waited for: no
         inputs yet; or stood for: mapping), sent again, does not, whenever it arrives (a
         stuck, stopped or arrived robot retries it). Returns whether the goal was new.
         ``goal`` (x, y) is in odom (the place odom puts there now), or with ``in_map`` in
         the memory's frame (the place in the world, as odom was at the start: what the
-        scan alignment keeps still)."""
+        scan alignment keeps still). ``path`` (k, 2), in the goal's frame: a way to the
+        goal the navigation field favours (Planner.follow; a goal sent again with a path
+        takes the new path); a new goal without one has none."""
         goal = np.asarray(goal, float)
         if self.goal is not None \
                 and self.state in (State.DRIVING, State.WAITING, State.MAPPING) \
                 and np.hypot(*(goal - self.goal)) < SAME_GOAL \
                 and in_map == self.goal_in_map:
+            if path is not None:
+                self.planner.follow(path, in_map)
             return False
         self.goal, self.goal_in_map = goal.copy(), bool(in_map)
         self.planner.reset()
+        self.planner.follow(path, in_map)
         for s in self.supervisors:
             s.reset()
         self.recoveries.tried = 0
@@ -199,6 +206,36 @@ class DecisionLoop:
     def clear_goal(self) -> None:
         """The goal is done (reached): none until the next."""
         self.goal = None
+
+    def know(self, known: KnownMap | None) -> None:
+        """Start the memory from a map the robot already has (core/known_map.py; its pose
+        the map frame's in the memory's frame); None: from the scans alone."""
+        self.planner.know(known)
+
+    def cancel(self, reason: str = 'goal canceled') -> None:
+        """Drop the goal (canceled, or the node deactivated): idle, for ``reason``, until
+        the next goal; the planner's last command is forgotten, the memory stays."""
+        self.goal = None
+        self.planner.reset()
+        self._set(State.IDLE, reason)
+
+    def remaining(self, result: PlanResult | None) -> float:
+        """Distance [m] left to the goal after the tick that gave ``result``: along the
+        navigation field's descent where there is a field (the way the robot is led;
+        straight on from where the descent stops, 30 m on), else straight from the
+        newest odometry; nan without a goal or a pose. A query: changes nothing."""
+        if self.goal is None:
+            return math.nan
+        if result is not None and result.field is not None and result.pose is not None:
+            path = result.field.path(result.pose[:2])
+            if len(path):
+                legs = np.diff(np.vstack([result.pose[:2], path, result.field.goal[:2]]),
+                               axis=0)
+                return float(np.sum(np.hypot(legs[:, 0], legs[:, 1])))
+        if self.pose is None:
+            return math.nan
+        goal = to_parent(self.correction, self.goal)[0] if self.goal_in_map else self.goal
+        return float(np.hypot(*(goal - self.pose[:2])))
 
     def clock_jumped(self) -> None:
         """The clock jumped (a restarted simulation, a bag played from elsewhere): forget

@@ -32,7 +32,8 @@ from scipy import ndimage
 
 from .alignment import DistanceField, Match, align, distance_field
 from .config import PlannerConfig
-from .navigation import NavigationField, compute_field, nearest_free
+from .known_map import KnownMap
+from .navigation import NavigationField, compute_field, densify, nearest_free
 from .occupancy import ESTABLISHED, NOT_ESTABLISHED, OccupancyGrid
 from .robot import compose, to_parent
 from .scan import Scan
@@ -77,8 +78,19 @@ class FieldJob:
     key: tuple
     #: When the cycle took the map [s].
     time: float
-    #: The way the robot has taken to the goal, the field favours (compute_field's route).
-    route: NDArray[np.float64] | None = None
+    #: The way the field favours (compute_field's route), how much cheaper travel along
+    #: it is and within what half-width [m] (Route).
+    route: Route | None = None
+
+
+@dataclass(frozen=True)
+class Route:
+    """A polyline (k, 2) [m] in the memory's frame the field favours: travel within
+    ``width`` [m] of it costs ``discount`` less (compute_field's route)."""
+
+    points: NDArray[np.float64]
+    discount: float
+    width: float
 
 
 class NavigationMemory:
@@ -109,6 +121,11 @@ class NavigationMemory:
         #: goal key it leads to: the next field of that goal favours it (route_discount).
         self.route: NDArray[np.float64] | None = None
         self._route_goal: tuple | None = None
+        #: A path given to follow (x, y) (k, 2) in the memory's frame, points at most a
+        #: cell apart (follow): favoured by path_discount instead of the route taken.
+        self.path: NDArray[np.float64] | None = None
+        #: A map the robot already has, the grid's prior (know).
+        self.known: KnownMap | None = None
 
     def reconfigure(self, cfg: PlannerConfig) -> None:
         """A new configuration; a new map size or resolution, or the scan alignment
@@ -120,9 +137,20 @@ class NavigationMemory:
         self._field_key = None
         self._drop_pending()
 
+    def know(self, known: KnownMap | None) -> None:
+        """Start the grid from ``known`` (core/known_map.py; None: from nothing, as the
+        cells leave the window), and keep it through ``forget``."""
+        self.known = known
+        self.grid.know(known)
+        self._field_key, self._distance, self._hard_free_cache = None, None, None
+        self._drop_pending()
+
     def forget(self) -> None:
-        """Drop the map and the field (the world may have changed: a restarted simulation)."""
+        """Drop the map and the field (the world may have changed: a restarted
+        simulation); a known map is taken again."""
         self.grid = _grid(self.cfg)
+        if self.known is not None:
+            self.grid.know(self.known)
         self.field, self._field_key, self._field_time = None, None, -math.inf
         self._scan_stamp = None
         self._distance, self._distance_age = None, 0
@@ -168,7 +196,7 @@ class NavigationMemory:
                              key, now, self._route_for(key))
 
     def _compute(self, blocked: NDArray[np.bool_], origin: NDArray, goal: NDArray,
-                 position: NDArray, route: NDArray | None
+                 position: NDArray, route: Route | None
                  ) -> tuple[NavigationField | None, float, NDArray | None]:
         """The field, how long it took [s], and, with route_discount, its descent from
         ``position`` (the route the next field favours)."""
@@ -177,17 +205,36 @@ class NavigationMemory:
         field = compute_field(blocked, origin, self.grid.resolution, goal, position,
                               inflation_radius=cfg.inflation_radius,
                               clearance_band=cfg.inflation_band,
-                              coarsening=cfg.field_coarsening, route=route,
-                              route_discount=cfg.route_discount, route_width=cfg.route_width,
+                              coarsening=cfg.field_coarsening,
+                              route=None if route is None else route.points,
+                              route_discount=0.0 if route is None else route.discount,
+                              route_width=0.0 if route is None else route.width,
                               gap_clearance=cfg.gap_clearance, goal_slack=cfg.goal_slack)
         seconds = time.perf_counter() - t0
-        if field is None or cfg.route_discount <= 0.0:
+        if field is None or cfg.route_discount <= 0.0 or self.path is not None:
             return field, seconds, None
         return field, seconds, field.path(position, ROUTE_LENGTH)
 
-    def _route_for(self, key: tuple) -> NDArray | None:
-        """The route a field for ``key`` favours: the last one, if it led to that goal."""
-        return self.route if self._route_goal == key[0] else None
+    def _route_for(self, key: tuple) -> Route | None:
+        """The route a field for ``key`` favours: a path given to follow, else the last
+        route taken, if it led to that goal."""
+        cfg = self.cfg
+        if self.path is not None:
+            return Route(self.path, cfg.path_discount, cfg.path_width)
+        if self.route is None or self._route_goal != key[0]:
+            return None
+        return Route(self.route, cfg.route_discount, cfg.route_width)
+
+    def follow(self, path: ArrayLike | None) -> None:
+        """Favour ``path`` (k, 2) [m] in the memory's frame (None: no path) in the
+        fields from now on (path_discount): the next field is computed afresh."""
+        if path is None:
+            self.path = None
+        else:
+            self.path = densify(np.asarray(path, float).reshape(-1, 2), self.grid.resolution)
+            self.route, self._route_goal = None, None
+        self._field_key = None
+        self._drop_pending()
 
     def _install(self, computed: tuple[NavigationField | None, float, NDArray | None],
                  key: tuple, when: float) -> None:

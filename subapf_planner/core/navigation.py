@@ -235,6 +235,21 @@ def thin_polyline(points: ArrayLike, spacing: float) -> NDArray[np.float64]:
     return p[keep]
 
 
+def densify(points: ArrayLike, spacing: float) -> NDArray[np.float64]:
+    """The polyline (k, 2) [m] with points added on each segment so that none are more
+    than ``spacing`` [m] apart (its own points kept, in order); non-finite points
+    dropped first."""
+    p = np.asarray(points, float).reshape(-1, 2)
+    p = p[np.all(np.isfinite(p), axis=1)]
+    if len(p) < 2 or spacing <= 0.0:
+        return p.copy()
+    out = [p[:1]]
+    for a, b in zip(p[:-1], p[1:], strict=True):
+        n = max(int(math.ceil(np.hypot(*(b - a)) / spacing)), 1)
+        out.append(a + (b - a) * (np.arange(1, n + 1) / n)[:, None])
+    return np.vstack(out)
+
+
 def crop_box(occupied: NDArray[np.bool_], cells: NDArray[np.int64],
              margin: int) -> tuple[int, int, int, int]:
     """(r0, r1, c0, c1): the box of the occupied cells and ``cells`` (k, 2), grown by

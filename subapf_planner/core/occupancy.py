@@ -30,6 +30,7 @@ import math
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from .known_map import KnownMap, prior
 from .scan import Scan
 
 #: Log-odds increments and clamps (a hit outweighs two misses).
@@ -46,6 +47,8 @@ HIT_MEMORY = 20
 ESTABLISHED = 2.0
 #: OccupancyGrid.established_at of a cell that is not established.
 NOT_ESTABLISHED = np.iinfo(np.int32).max
+#: A known map's walls count as established this many scans before the first.
+PRIOR_AGE = 1000
 
 
 def cell_index(points: ArrayLike, origin: ArrayLike, resolution: float) -> NDArray[np.int64]:
@@ -89,6 +92,9 @@ class OccupancyGrid:
         self.scans = 0
         self.origin = np.array([-0.5, -0.5]) * self.cells * self.resolution
         self.version = 0   # bumped whenever the occupied set (log odds > 0) changed
+        #: A map the robot already has (core/known_map.py): each cell the window takes
+        #: in starts from it (None: unknown).
+        self.known: KnownMap | None = None
 
     # --- geometry ---------------------------------------------------------------------
     @property
@@ -123,6 +129,27 @@ class OccupancyGrid:
             if self.established_at is not None:
                 self.established_at[cells[hit, 0], cells[hit, 1]] = NOT_ESTABLISHED
             self.version += 1
+
+    def know(self, known: KnownMap | None) -> None:
+        """Start every cell of the window from ``known`` now, and each cell a shift
+        brings in later (None: cells come in unknown again; those in the window stay)."""
+        self.known = known
+        if known is not None:
+            self._take_prior(np.ones((self.cells, self.cells), bool))
+
+    def _take_prior(self, fresh: NDArray[np.bool_]) -> None:
+        """The ``fresh`` cells (a mask of the window) from the known map: its walls as
+        walls established PRIOR_AGE scans ago, where returns fell not known (the cell's
+        centre)."""
+        rows, cols = np.nonzero(fresh)
+        values, wall = prior(self.known, self.centre_of(np.column_stack((rows, cols))))
+        self.log_odds[rows, cols] = values
+        if self.hit_offset is not None:
+            self.hit_offset[rows, cols] = 0.0
+            self.hit_count[rows, cols] = 0
+            self.established_at[rows, cols] = NOT_ESTABLISHED
+            self.established_at[rows[wall], cols[wall]] = self.scans - PRIOR_AGE
+        self.version += 1
 
     def occupied(self) -> NDArray[np.bool_]:
         """Occupied cells (log odds > 0), a new array."""
@@ -171,6 +198,11 @@ class OccupancyGrid:
         self.log_odds, self.hit_offset, self.hit_count, self.established_at = layers
         self.origin = new_origin
         self.version += 1
+        if self.known is not None:   # the cells that came in start from the known map
+            fresh = np.ones((n, n), bool)
+            if abs(dx) < n and abs(dy) < n:
+                fresh[dst_r, dst_c] = False
+            self._take_prior(fresh)
 
     # --- scans ------------------------------------------------------------------------
     def update(self, scan: Scan, laser_pose: ArrayLike, clear_range: float = math.inf,

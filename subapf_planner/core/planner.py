@@ -40,6 +40,7 @@ from .command import Command
 from .config import PlannerConfig
 from .cycle import Cycle, PlanResult
 from .gates import goal_status, input_status
+from .known_map import KnownMap
 from .memory import SAME_GOAL, NavigationMemory
 from .navigation import NavigationField
 from .pipeline import Pipeline
@@ -315,6 +316,21 @@ class Planner:
         dt = t - self.tracker.time if math.isfinite(t) and self.tracker.time is not None \
             else 0.0
         return last.position[keep] + dt * last.velocity[keep], last.radius[keep]
+
+    def know(self, known: KnownMap | None) -> None:
+        """Start the memory from a map the robot already has (its pose in the memory's
+        frame in it; None: none): NavigationMemory.know."""
+        self.memory.know(known)
+
+    def follow(self, path: ArrayLike | None, in_map: bool = False) -> None:
+        """Favour ``path`` (k, 2) [m] in the navigation field (path_discount) until the
+        next call; None: no path. A path in odom (``in_map`` False) is anchored as a goal
+        is: the places odom has there now."""
+        if path is None:
+            self.memory.follow(None)
+            return
+        p = np.asarray(path, float).reshape(-1, 2)
+        self.memory.follow(p if in_map else to_parent(self.correction, p))
 
     def _anchored(self, goal: NDArray) -> NDArray[np.float64]:
         """The goal (x, y) in the memory's frame: a goal given in odom is the place odom

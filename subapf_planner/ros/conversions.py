@@ -105,6 +105,17 @@ def odom_to_msg(pose: np.ndarray, twist: tuple[float, float], stamp: float,
     return msg
 
 
+def pose_msg(pose: np.ndarray, frame: str, stamp: Time) -> PoseStamped:
+    """A planar pose (x, y, yaw) [m, m, rad] as geometry_msgs/PoseStamped."""
+    msg = PoseStamped()
+    msg.header.frame_id = frame
+    msg.header.stamp = stamp
+    msg.pose.position.x, msg.pose.position.y = float(pose[0]), float(pose[1])
+    msg.pose.orientation.z = math.sin(0.5 * float(pose[2]))
+    msg.pose.orientation.w = math.cos(0.5 * float(pose[2]))
+    return msg
+
+
 def transform_msg(parent: str, child: str, xyz: tuple[float, float, float], yaw: float,
                   stamp: float) -> TransformStamped:
     """A TransformStamped parent -> child (REP-105 frames), rotation about z only."""

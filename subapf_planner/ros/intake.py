@@ -16,7 +16,7 @@ in the same way:
 * a goal in a frame other than ``odom_frame`` (or empty) or ``map_frame`` (the
   memory's frame: odom as it was at the start, kept still by the scan
   alignment), or with a non-finite position, is refused (an error), the
-  previous goal kept.
+  previous goal kept; a path to follow (ros/actions.py) the same, and an empty one.
 """
 
 from __future__ import annotations
@@ -24,7 +24,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from geometry_msgs.msg import PoseStamped
-from nav_msgs.msg import Odometry
+from nav_msgs.msg import Odometry, Path
 import numpy as np
 from sensor_msgs.msg import LaserScan
 
@@ -68,13 +68,25 @@ class Intake:
     def goal(self, loop: DecisionLoop, msg: PoseStamped) -> tuple[bool, str | None]:
         """Take a goal: (whether it is a new goal, the reason it was refused or None)."""
         goal = np.array([msg.pose.position.x, msg.pose.position.y], dtype=float)
-        frame = msg.header.frame_id
+        return self._goal(loop, goal, msg.header.frame_id, None)
+
+    def path(self, loop: DecisionLoop, msg: Path) -> tuple[bool, str | None]:
+        """Take a path to follow (its last pose the goal; the path's frame): as goal."""
+        points = np.array([[p.pose.position.x, p.pose.position.y] for p in msg.poses],
+                          dtype=float).reshape(-1, 2)
+        if not len(points):
+            return False, 'an empty path refused'
+        return self._goal(loop, points[-1], msg.header.frame_id, points)
+
+    def _goal(self, loop: DecisionLoop, goal: np.ndarray, frame: str,
+              path: np.ndarray | None) -> tuple[bool, str | None]:
+        what = 'goal' if path is None else 'path'
         if frame not in ('', self.odom_frame, self.map_frame):
-            return False, (f'goal in frame "{frame}" refused: give it in '
+            return False, (f'{what} in frame "{frame}" refused: give it in '
                            f'"{self.odom_frame}" or "{self.map_frame}"')
-        if not np.all(np.isfinite(goal)):
-            return False, 'goal with a non-finite position refused'
-        return loop.set_goal(goal, in_map=frame == self.map_frame), None
+        if not np.all(np.isfinite(goal)) or (path is not None and not np.all(np.isfinite(path))):
+            return False, f'{what} with a non-finite position refused'
+        return loop.set_goal(goal, in_map=frame == self.map_frame, path=path), None
 
 
 def _ahead(what: str, msg, now: float) -> str | None:

@@ -54,12 +54,13 @@ from ..core.loop import DecisionLoop, Supervision
 from ..core.navigation import thin_polyline
 from ..core.params import check_fields, param
 from ..core.robot import ROBOTS, RobotDescription, chain, invert, to_parent
+from .actions import navigation_actions
 from .conversions import cmd_to_msg, grid_to_msg, path_to_msg, planar_transform, transform_msg
 from .intake import Intake
 from .markers import markers_from_result
 from .parameters import declare, read, warn_undeclared
 from .qos import LATCHED, listened, unheard_publishers
-from .spinning import PolledGroup, spin_node
+from .spinning import SHUTDOWN_ACK_TIMEOUT, PolledGroup, spin_node
 from .usage import node_usage
 
 NODE_NAME = 'subapf_planner'
@@ -138,14 +139,28 @@ SECTIONS = (('node (ros/planner_node.py)', NodeOptions),
 GROUPS = tuple(cls for _, cls in SECTIONS)
 
 
-class PlannerNode(Node):
-    """Runs the core planner on a timer; every safety decision stops the robot."""
+class PlannerParts:
+    """The planner node's work, set up in the two steps of a managed node (Nav2's
+    servers): ``_configure`` (parameters read, the decision loop built, publishers,
+    subscriptions and action servers made) and ``_activate`` (the planning timer);
+    ``_deactivate`` and ``_cleanup`` undo them. PlannerNode does both at once;
+    ros/lifecycle_node.py's node on its transitions. A mixin of an rclpy Node."""
 
-    def __init__(self, **kwargs) -> None:
-        super().__init__(NODE_NAME, **kwargs)
+    #: Configured and not yet cleaned up; active (the timer running).
+    configured = False
+    active = False
+
+    def _declare_parameters(self) -> None:
         declare(self, *GROUPS)
         warn_undeclared(self)   # a misspelt name: said, with the closest one
-        # a bad start value raises ConfigError naming it (exit code 2)
+
+    def _make_publisher(self, msg_type, topic: str, qos):
+        return self.create_publisher(msg_type, topic, qos)
+
+    def _configure(self) -> None:
+        """Read the parameters (a bad value raises ConfigError naming it) and make
+        everything but the timer; nothing is published until _activate."""
+        self._undo: list = []   # how to take each part down again, in order made
         self.options = read(self, NodeOptions)
         self.ctl = DecisionLoop(self._within_robot(read(self, PlannerConfig)),
                                 read(self, Supervision))
@@ -153,26 +168,28 @@ class PlannerNode(Node):
         self._pending: dict[type, object] = {}   # groups validated by the on-set callback
         self.add_on_set_parameters_callback(self._validate_parameters)
         self.add_post_set_parameters_callback(self._apply_parameters)
+        self._undo += [
+            lambda: self.remove_on_set_parameters_callback(self._validate_parameters),
+            lambda: self.remove_post_set_parameters_callback(self._apply_parameters)]
 
         stamped = self.options.enable_stamped_cmd_vel
-        self.cmd_pub = self.create_publisher(TwistStamped if stamped else Twist, 'cmd_vel', 10)
-        self.status_pub = self.create_publisher(String, '~/status', 10)
-        self.marker_pub = self.create_publisher(MarkerArray, '~/markers', 10)
-        self.map_pub = self.create_publisher(GridMsg, '~/map', LATCHED)
-        self.plan_pub = self.create_publisher(Path, '~/plan', 10)
-        self.correction_pub = self.create_publisher(TransformStamped, '~/correction', 10)
+        self.cmd_pub = self._publisher(TwistStamped if stamped else Twist, 'cmd_vel', 10)
+        self.status_pub = self._publisher(String, '~/status', 10)
+        self.marker_pub = self._publisher(MarkerArray, '~/markers', 10)
+        self.map_pub = self._publisher(GridMsg, '~/map', LATCHED)
+        self.plan_pub = self._publisher(Path, '~/plan', 10)
+        self.correction_pub = self._publisher(TransformStamped, '~/correction', 10)
         self._map_time: float | None = None
         self._markers_time: float | None = None
         self._plan_sent: tuple | None = None   # (field, robot position, time) of ~/plan
         # taken at the tick (_take_arrived_inputs), never by the executor
         polled = PolledGroup()
         self._inputs = (
-            (self.create_subscription(LaserScan, 'scan', self._on_scan, qos_profile_sensor_data,
-                                      callback_group=polled), self._on_scan),
-            (self.create_subscription(Odometry, 'odom', self._on_odom,
-                                      QoSProfile(depth=ODOM_QUEUE), callback_group=polled),
-             self._on_odom))
-        self.create_subscription(PoseStamped, 'goal_pose', self._on_goal, 10)
+            (self._subscription(LaserScan, 'scan', self._on_scan, qos_profile_sensor_data,
+                                callback_group=polled), self._on_scan),
+            (self._subscription(Odometry, 'odom', self._on_odom, QoSProfile(depth=ODOM_QUEUE),
+                                callback_group=polled), self._on_odom))
+        self._subscription(PoseStamped, 'goal_pose', self._on_goal, 10)
         self._silence_checked = -float('inf')   # when the silent inputs were looked at
         self._unheard: set[bytes] = set()   # publishers warned about (endpoint GIDs)
 
@@ -182,19 +199,60 @@ class PlannerNode(Node):
         self._tf_mount: tuple[float, float, float] | None = None
         self._setup_tf_static()
         self._last_state = ''
-        if self.options.goal_from_parameters:
-            self._set_goal(np.array([self.options.goal_x, self.options.goal_y]))
-        cfg = self.ctl.cfg
-        self.timer = self.create_timer(cfg.period, self._on_timer)
-        self._jump_handle = self.get_clock().create_jump_callback(
+        self.timer = None
+        jump = self.get_clock().create_jump_callback(
             JumpThreshold(min_forward=Duration(seconds=CLOCK_JUMP),
                           min_backward=Duration(nanoseconds=-1), on_clock_change=False),
             post_callback=self._on_clock_jump)
+        self._undo.append(jump.unregister)
+        self.actions = navigation_actions(self)
+        if self.actions is not None:
+            self._undo.append(self.actions.destroy)
+        self.configured = True
+
+    def _publisher(self, msg_type, topic: str, qos):
+        pub = self._make_publisher(msg_type, topic, qos)
+        self._undo.append(lambda: self._destroy_publisher(pub))
+        return pub
+
+    def _destroy_publisher(self, pub) -> None:
+        self.destroy_publisher(pub)
+
+    def _subscription(self, msg_type, topic: str, callback, qos, **kwargs):
+        sub = self.create_subscription(msg_type, topic, callback, qos, **kwargs)
+        self._undo.append(lambda: self.destroy_subscription(sub))
+        return sub
+
+    def _activate(self) -> None:
+        """Start planning: the timer (and the goal of the parameters, if asked)."""
+        cfg = self.ctl.cfg
+        self.timer = self.create_timer(cfg.period, self._on_timer)
+        self.active = True
+        if self.options.goal_from_parameters:
+            self._set_goal(np.array([self.options.goal_x, self.options.goal_y]))
         self.get_logger().info(
             f'method={cfg.method} d0={cfg.danger_distance} m '
             f'samples={cfg.num_samples} R={cfg.sample_radius} m '
             f'rate={cfg.planning_frequency} Hz v_max={cfg.max_linear_velocity} m/s '
-            f'cmd_vel={"TwistStamped" if stamped else "Twist"}')
+            f'cmd_vel={self.cmd_pub.msg_type.__name__}')
+
+    def _deactivate(self, why: str) -> None:
+        """Stop planning: the goal dropped (an action's goal aborted with ``why``), a zero
+        command sent and acknowledged (bounded), the timer gone."""
+        if self.timer is not None:
+            self.destroy_timer(self.timer)
+            self.timer = None
+        if self.actions is not None:
+            self.actions.preempt(why)
+        self.cancel_goal(why)
+        self.active = False
+
+    def _cleanup(self) -> None:
+        """Take down everything _configure made (in reverse order)."""
+        for undo in reversed(getattr(self, '_undo', [])):
+            undo()
+        self._undo = []
+        self.configured = False
 
     # --- parameters -------------------------------------------------------------------
     def _within_robot(self, cfg: PlannerConfig) -> PlannerConfig:
@@ -236,7 +294,8 @@ class PlannerNode(Node):
         if not pending:
             return
         cfg = pending[PlannerConfig]
-        if cfg.planning_frequency != self.ctl.cfg.planning_frequency:
+        if cfg.planning_frequency != self.ctl.cfg.planning_frequency \
+                and self.timer is not None:
             self.timer.timer_period_ns = int(cfg.period * 1e9)
         self.options = pending[NodeOptions]
         self.intake = self._intake()
@@ -251,7 +310,7 @@ class PlannerNode(Node):
             self.get_logger().info(f'laser mounting from parameters {self.ctl.cfg.laser_mount}'
                                    ' (tf2_msgs not installed: /tf_static not read)')
             return
-        self.create_subscription(TFMessage, '/tf_static', self._on_tf_static, LATCHED)
+        self._subscription(TFMessage, '/tf_static', self._on_tf_static, LATCHED)
         self.get_logger().info(f'laser mounting from parameters {self.ctl.cfg.laser_mount} '
                                f'until /tf_static gives {o.base_frame} -> {o.laser_frame}')
 
@@ -304,11 +363,44 @@ class PlannerNode(Node):
         self._warn(self.intake.odom(self.ctl, msg, self._now()))
 
     def _on_goal(self, msg: PoseStamped) -> None:
+        if not self.active:
+            self.get_logger().warn('goal_pose ignored: the planner is not active')
+            return
         new, refused = self.intake.goal(self.ctl, msg)
+        if refused:
+            self.get_logger().error(refused)
+            return
+        if self.actions is not None:
+            self.actions.preempt('preempted by a goal on goal_pose')
+        if new:
+            self._took_goal()
+
+    def take_goal(self, msg: PoseStamped | Path) -> str | None:
+        """A goal (a pose, or a path to follow to its end) from an action: taken (None),
+        or why it is refused."""
+        new, refused = (self.intake.path if isinstance(msg, Path) else self.intake.goal)(
+            self.ctl, msg)
         if refused:
             self.get_logger().error(refused)
         elif new:
             self._took_goal()
+        return refused
+
+    def cancel_goal(self, why: str) -> None:
+        """Drop the goal for ``why`` and stop the robot: a zero velocity sent and
+        acknowledged (at most SHUTDOWN_ACK_TIMEOUT)."""
+        self.ctl.cancel(why)
+        self.stop_robot()
+        if not self.cmd_pub.wait_for_all_acked(
+                Duration(nanoseconds=int(SHUTDOWN_ACK_TIMEOUT * 1e9))):
+            self.get_logger().warn(f'{why}: the zero velocity was not acknowledged within '
+                                   f'{SHUTDOWN_ACK_TIMEOUT} s')
+        self._last_state = self.ctl.text
+        if listened(self.status_pub):
+            self.status_pub.publish(String(data=self.ctl.text))
+
+    def now_seconds(self) -> float:
+        return self._now()
 
     def _set_goal(self, goal: np.ndarray) -> None:
         if self.ctl.set_goal(goal):
@@ -360,6 +452,8 @@ class PlannerNode(Node):
                     self.get_logger().warn(problem)
 
     def _on_timer(self) -> None:
+        if self.actions is not None:
+            self.actions.before_tick()   # a cancel request first: no command after it
         tick = self.get_clock().now()
         later = self._take_arrived_inputs(tick.nanoseconds)
         self._explain_silence(tick.nanoseconds * 1e-9)
@@ -378,6 +472,8 @@ class PlannerNode(Node):
         self._last_state = decision.text
         if listened(self.status_pub):
             self.status_pub.publish(String(data=decision.text))
+        if self.actions is not None:
+            self.actions.after_tick(decision, tick.to_msg())
 
     def _publish_views(self, decision, tick) -> None:
         """~/markers at marker_rate and ~/correction each cycle, each only while
@@ -434,8 +530,20 @@ class PlannerNode(Node):
                                         stamp or self.get_clock().now().to_msg()))
 
     def stop_robot(self) -> None:
-        """Zero velocity, e.g. on shutdown."""
-        self._publish_cmd(0.0, 0.0)
+        """Zero velocity, e.g. on shutdown (nothing while not active: a managed node's
+        publishers are off then)."""
+        if self.active:
+            self._publish_cmd(0.0, 0.0)
+
+
+class PlannerNode(PlannerParts, Node):
+    """Runs the core planner on a timer; every safety decision stops the robot."""
+
+    def __init__(self, **kwargs) -> None:
+        super().__init__(NODE_NAME, **kwargs)
+        self._declare_parameters()
+        self._configure()   # a bad start value raises ConfigError naming it (exit code 2)
+        self._activate()
 
 
 def _due(last: float | None, now: float, period: float, tick: float) -> bool:

@@ -1,0 +1,280 @@
+"""The planner in a Nav2 system, over DDS: the navigate_to_pose action driven as
+nav2_simple_commander drives it (test/nav2_client.py, a process that can import
+nav2_msgs: built by conftest's nav2_msgs_built where no ROS install has it), and the
+managed node driven through its lifecycle services as nav2_lifecycle_manager drives
+it. sim_node closes the loop on an open floor."""
+
+import json
+import queue
+import subprocess
+import sys
+import threading
+
+from conftest import PARAMS, REPO, wait_for, with_paths
+from geometry_msgs.msg import PoseStamped, TwistStamped
+from lifecycle_msgs.msg import Transition
+from lifecycle_msgs.srv import ChangeState, GetState
+from nav_msgs.msg import Odometry
+import numpy as np
+import pytest
+import rclpy
+from rclpy.executors import SingleThreadedExecutor
+from std_msgs.msg import String
+
+from subapf_planner.ros.conversions import pose_from_odom
+from subapf_planner.ros.processes import join_domain, start, stop
+
+pytestmark = pytest.mark.dds
+
+#: An open floor with one round obstacle (a goal inside it is occupied).
+WORLD = """\
+name: open_floor
+start: [0.0, 0.0, 0.0]
+goal: [1.0, 0.0]
+time_limit: 600
+obstacles:
+  - circle: {center: [1.0, 1.6], radius: 0.35}
+"""
+RATE = 2.0
+#: Ground truth this close to a goal: arrived (the goal tolerance and a little).
+AT_GOAL = 0.15
+
+
+class Graph:
+    """sim_node and a planner (planner_node or lifecycle_planner_node) as child
+    processes; here a node that hears ground truth, cmd_vel and the planner's status;
+    a navigate_to_pose client process (nav2_client.py) fed one task at a time."""
+
+    def __init__(self, domain: int, tmp_path, nav2_paths: dict, planner='planner_node',
+                 planner_args=()):
+        self.log_dir = tmp_path
+        world = tmp_path / 'open_floor.yaml'
+        world.write_text(WORLD)
+        self.env = with_paths(join_domain(domain), nav2_paths)
+        self.context = rclpy.Context()
+        rclpy.init(context=self.context)
+        self.node = rclpy.create_node('watcher', context=self.context)
+        self.ex = SingleThreadedExecutor(context=self.context)
+        self.ex.add_node(self.node)
+        self.pose = None
+        self.speed = None
+        self.track: list = []   # ground-truth positions
+        self.cmds: list[tuple[float, float]] = []
+        self.states: list[str] = []
+        self.node.create_subscription(Odometry, 'ground_truth', self._on_truth, 10)
+        self.node.create_subscription(TwistStamped, 'cmd_vel', lambda m: self.cmds.append(
+            (m.twist.linear.x, m.twist.angular.z)), 100)
+        self.node.create_subscription(String, '/subapf_planner/status',
+                                      lambda m: self.states.append(m.data), 100)
+        self.children = [
+            start('sim_node', ['-p', f'world:={world}', '-p', f'rate:={RATE}'], self.env,
+                  log=tmp_path / 'sim.log'),
+            start(planner, ['--params-file', str(PARAMS), '-p', 'use_sim_time:=true',
+                            *planner_args], self.env, log=tmp_path / 'planner.log')]
+        self.client = None
+        self.answers: queue.Queue = queue.Queue()
+
+    def _on_truth(self, msg):
+        self.pose = pose_from_odom(msg)
+        self.track.append(self.pose[:2])
+        self.speed = abs(msg.twist.twist.linear.x) + abs(msg.twist.twist.angular.z)
+
+    def logs(self) -> str:
+        return '\n'.join(f'--- {f.name}\n' + f.read_text()[-3000:]
+                         for f in sorted(self.log_dir.glob('*.log')))
+
+    def until(self, predicate, timeout: float, what: str):
+        def spun():
+            self.ex.spin_once(timeout_sec=0.05)
+            assert all(c.poll() is None for c in self.children), self.logs()
+            return predicate()
+        return wait_for(spun, timeout, lambda: f'{what}\n{self.logs()}', interval=0.0)
+
+    def ask(self, task: str, timeout: float = 240.0) -> list[dict]:
+        """One task for the client (nav2_client.py); its results."""
+        if self.client is None:
+            self.client = subprocess.Popen(
+                [sys.executable, str(REPO / 'test' / 'nav2_client.py')], env=self.env,
+                stdin=subprocess.PIPE, stdout=subprocess.PIPE,
+                stderr=open(self.log_dir / 'client.log', 'w'), text=True)
+            threading.Thread(target=self._read, daemon=True).start()
+        self.client.stdin.write(task + '\n')
+        self.client.stdin.flush()
+        self.until(lambda: not self.answers.empty(), timeout, f'the answer to {task}')
+        return json.loads(self.answers.get())['results']
+
+    def _read(self):
+        for line in self.client.stdout:
+            self.answers.put(line)
+
+    def close(self):
+        if self.client is not None:
+            self.client.stdin.close()
+            self.client.wait(timeout=10)
+        stop(self.children)
+        self.node.destroy_node()
+        rclpy.try_shutdown(context=self.context)
+
+
+@pytest.fixture
+def graph(ros_env, tmp_path, nav2_msgs_built):
+    g = Graph(int(ros_env['ROS_DOMAIN_ID']), tmp_path, nav2_msgs_built)
+    yield g
+    g.close()
+
+
+def near(graph: Graph, xy) -> float:
+    graph.until(lambda: graph.pose is not None, 30, 'ground truth')
+    return float(np.hypot(*(graph.pose[:2] - np.asarray(xy, float))))
+
+
+def test_a_goal_succeeds_with_feedback_and_a_second_goal_preempts_the_first(graph):
+    [done] = graph.ask('goal 1.0 0.0')
+    assert done['status'] == 'SUCCEEDED', (done['status'], done['error_msg'], graph.logs())
+    assert near(graph, (1.0, 0.0)) < AT_GOAL
+    fb = done['feedback']
+    assert len(fb) >= 5 and all(f['frame'] == 'odom' for f in fb)
+    assert fb[0]['distance_remaining'] > 0.7 and fb[-1]['distance_remaining'] < 0.3, fb
+    times = [f['navigation_time'] for f in fb]
+    assert np.all(np.diff(times) >= 0) and times[-1] > 3.0   # 1 m at 0.22 m/s at best
+    # the time left at top speed, for the distance left
+    f = fb[len(fb) // 2]
+    assert f['estimated_time_remaining'] == pytest.approx(f['distance_remaining'] / 0.22,
+                                                          abs=0.01)
+    # a second goal while the first is driven to: the first ABORTED (preempted), the
+    # second driven to
+    first, second = graph.ask('preempt 1.0 -1.5 -0.5 0.0')
+    assert first['status'] == 'ABORTED' and 'preempted' in first['error_msg'], first
+    assert second['status'] == 'SUCCEEDED', (second, graph.logs())
+    assert near(graph, (-0.5, 0.0)) < AT_GOAL
+
+
+def test_cancel_stops_the_robot_and_failures_end_aborted_with_a_reason(graph):
+    [canceled] = graph.ask('cancel 1.0 -2.0 2.0')
+    assert canceled['status'] == 'CANCELED', (canceled, graph.logs())
+    # before CANCELED came, the robot was sent a zero and it was acknowledged: the last
+    # command here is a zero, none but zeros follow, and the robot comes to rest short
+    # of the goal
+    assert graph.cmds and graph.cmds[-1] == (0.0, 0.0)
+    sent = len(graph.cmds)
+    graph.until(lambda: graph.speed is not None and graph.speed < 1e-3, 10, 'the robot at rest')
+    assert all(c == (0.0, 0.0) for c in graph.cmds[sent:])
+    assert near(graph, (1.0, -2.0)) > 0.5
+    graph.until(lambda: graph.states and graph.states[-1].startswith('idle'), 10, 'idle')
+    # a goal in a frame the planner does not know: aborted at once, the reason given
+    [frame] = graph.ask('goal 1.0 0.0 base_link')
+    assert frame['status'] == 'ABORTED' and frame['error_code'] == 202, frame
+    assert 'base_link' in frame['error_msg']
+    # a goal inside the obstacle, walled in by what the scan shows of it: aborted once
+    # unreachable_timeout (30 s) has passed, as Nav2's planner server would (NO_VALID_PATH)
+    [walled] = graph.ask('goal 1.0 1.6')
+    assert walled['status'] == 'ABORTED', (walled, graph.logs())
+    assert walled['error_code'] == 208, walled['error_msg']
+    assert walled['error_msg'].startswith('unreachable: no way to the goal')
+
+
+def test_a_path_is_followed_to_its_end_and_left_only_round_what_blocks_it(graph):
+    """follow_path: a path bending 1 m south of the straight way is driven along (the
+    field favours it: path_discount) to SUCCEEDED at its end; a path whose middle point
+    lies in the obstacle is left round it, without touching it, and its end reached."""
+    [bend] = graph.ask('path 0.0 0.0 1.0 -1.0 2.0 0.0')
+    assert bend['status'] == 'SUCCEEDED', (bend, graph.logs())
+    assert near(graph, (2.0, 0.0)) < AT_GOAL
+    track = np.array(graph.track)
+    assert np.hypot(*(track - (1.0, -1.0)).T).min() < 0.3   # it went by the bend
+    fb = bend['feedback']
+    # (along the path once there is a field: 2.8 m from the start; straight before)
+    assert max(f['distance_to_goal'] for f in fb) > 2.4 and fb[-1]['distance_to_goal'] < 0.3
+    assert max(f['speed'] for f in fb) > 0.15
+    graph.track.clear()
+    [through] = graph.ask('path 2.0 0.0 1.0 1.6 0.0 0.0')   # via the obstacle's centre
+    assert through['status'] == 'SUCCEEDED', (through, graph.logs())
+    assert near(graph, (0.0, 0.0)) < AT_GOAL
+    clearance = np.hypot(*(np.array(graph.track) - (1.0, 1.6)).T).min() - 0.35
+    assert 0.105 < clearance < 0.8, clearance   # round it, close to the path
+
+
+@pytest.fixture
+def managed(ros_env, tmp_path, nav2_msgs_built):
+    g = Graph(int(ros_env['ROS_DOMAIN_ID']), tmp_path, nav2_msgs_built,
+              planner='lifecycle_node')
+    yield g
+    g.close()
+
+
+class Lifecycle:
+    """The lifecycle services of the planner, called as nav2_lifecycle_manager calls
+    them."""
+
+    def __init__(self, graph: Graph):
+        self.graph = graph
+        self.change = graph.node.create_client(ChangeState, '/subapf_planner/change_state')
+        self.get = graph.node.create_client(GetState, '/subapf_planner/get_state')
+        graph.until(lambda: self.change.service_is_ready() and self.get.service_is_ready(),
+                    60, 'the lifecycle services')
+
+    def _call(self, client, request):
+        future = client.call_async(request)
+        self.graph.until(future.done, 30, f'{client.srv_name}')
+        return future.result()
+
+    def state(self) -> str:
+        return self._call(self.get, GetState.Request()).current_state.label
+
+    def transition(self, transition_id: int) -> bool:
+        request = ChangeState.Request()
+        request.transition.id = transition_id
+        return self._call(self.change, request).success
+
+
+def cmd_vel_publishers(graph: Graph) -> int:
+    return len(graph.node.get_publishers_info_by_topic('/cmd_vel'))
+
+
+def send_goal_pose(graph: Graph, x: float, y: float) -> None:
+    pub = graph.node.create_publisher(PoseStamped, 'goal_pose', 10)
+    goal = PoseStamped()
+    goal.header.frame_id = 'odom'
+    goal.pose.position.x, goal.pose.position.y = x, y
+    graph.until(lambda: pub.get_subscription_count() >= 1, 30, 'a goal_pose subscriber')
+    pub.publish(goal)
+
+
+def test_the_managed_planner_goes_through_its_states_as_nav2s_lifecycle_manager_drives_it(
+        managed):
+    graph = managed
+    lc = Lifecycle(graph)
+    assert lc.state() == 'unconfigured'
+    assert cmd_vel_publishers(graph) == 0
+    assert lc.transition(Transition.TRANSITION_CONFIGURE)
+    assert lc.state() == 'inactive'
+    graph.until(lambda: cmd_vel_publishers(graph) == 1, 10, 'cmd_vel advertised')
+    # inactive: an action goal is rejected, nothing is commanded
+    [rejected] = graph.ask('goal 1.0 0.0')
+    assert rejected['status'] == 'REJECTED'
+    assert not graph.cmds
+    assert lc.transition(Transition.TRANSITION_ACTIVATE)
+    assert lc.state() == 'active'
+    # active: it drives; deactivated while driving, it stops with a zero
+    send_goal_pose(graph, 2.5, 0.0)
+    graph.until(lambda: any(v > 0.05 for v, _ in graph.cmds), 60, 'driving')
+    assert lc.transition(Transition.TRANSITION_DEACTIVATE)
+    assert lc.state() == 'inactive'
+    assert graph.cmds[-1] == (0.0, 0.0)
+    sent = len(graph.cmds)
+    graph.until(lambda: graph.speed is not None and graph.speed < 1e-3, 10, 'the robot at rest')
+    assert near(graph, (2.5, 0.0)) > 0.5
+    # activated again it does not drive to the dropped goal; a new one it drives to
+    assert lc.transition(Transition.TRANSITION_ACTIVATE)
+    graph.until(lambda: graph.states and graph.states[-1].startswith('idle'), 10, 'idle')
+    assert all(c == (0.0, 0.0) for c in graph.cmds[sent:])
+    [done] = graph.ask('goal 0.5 0.0')
+    assert done['status'] == 'SUCCEEDED', (done, graph.logs())
+    # taken down and finalized
+    assert lc.transition(Transition.TRANSITION_DEACTIVATE)
+    assert lc.transition(Transition.TRANSITION_CLEANUP)
+    assert lc.state() == 'unconfigured'
+    graph.until(lambda: cmd_vel_publishers(graph) == 0, 10, 'cmd_vel no longer advertised')
+    assert lc.transition(Transition.TRANSITION_UNCONFIGURED_SHUTDOWN)
+    assert lc.state() == 'finalized'
+    assert 'Traceback' not in (graph.log_dir / 'planner.log').read_text()
