@@ -6,8 +6,9 @@ Starts the planner as a managed node (``lifecycle_planner_node``, node name
 ``nav2_lifecycle_manager`` that configures and activates it (``autostart``), as Nav2's
 bringup does for its servers. The planner offers no bond (the ``bond`` package), so the
 manager is told not to wait for one (``bond_timeout: 0.0``). Start Nav2's localisation
-beside it if the robot has a map (``nav2_bringup``'s localization_launch.py); the
-planner needs only ``scan`` and ``odom``. Parameters as planner.launch.py loads them.
+beside it if the robot has a map (``nav2_bringup``'s localization_launch.py): the
+planner's memory then starts from the map (``use_map``); it needs only ``scan`` and
+``odom``. Parameters as planner.launch.py loads them.
 """
 
 from launch import LaunchDescription

@@ -6,12 +6,15 @@ from builtin_interfaces.msg import Time
 import numpy as np
 import pytest
 
+from subapf_planner.core.known_map import KnownMap, KnownMapError
 from subapf_planner.core.occupancy import OccupancyGrid
 from subapf_planner.core.scan import Scan
 from subapf_planner.ros.conversions import (
     cmd_from_msg,
     cmd_to_msg,
     grid_to_msg,
+    known_map_from_msg,
+    known_map_to_msg,
     odom_to_msg,
     path_to_msg,
     pose_from_odom,
@@ -125,3 +128,21 @@ def test_footprint_marker_outlines_the_robot_and_points_its_heading():
         np.testing.assert_allclose(xy[0], pose[:2] + radius * np.array([np.cos(0.5),
                                                                          np.sin(0.5)]))
         np.testing.assert_allclose(xy[-1], pose[:2])   # the heading ends at the centre
+
+
+def test_a_map_message_round_trips_and_a_malformed_one_is_refused():
+    cells = np.zeros((3, 4), np.int8)
+    cells[1, 2], cells[0, 0] = 100, -1
+    msg = known_map_to_msg(KnownMap(cells, (1.0, -2.0), 0.05), 'map', Time())
+    assert (msg.info.width, msg.info.height, msg.header.frame_id) == (4, 3, 'map')
+    back = known_map_from_msg(msg)
+    assert np.array_equal(back.cells, cells) and back.resolution == pytest.approx(0.05)
+    # (the origin is the placement: the same cells at the same places)
+    assert back.at([(1.0 + 2.5 * 0.05, -2.0 + 1.5 * 0.05)])[0] == 100
+    msg.data = msg.data[:-1]
+    with pytest.raises(KnownMapError):
+        known_map_from_msg(msg)
+    msg = known_map_to_msg(KnownMap(cells, (0.0, 0.0), 0.05), 'map', Time())
+    msg.info.resolution = 0.0
+    with pytest.raises(KnownMapError):
+        known_map_from_msg(msg)

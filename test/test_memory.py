@@ -262,6 +262,20 @@ def test_a_path_given_to_follow_is_descended_and_left_where_the_memory_blocks_it
     assert np.abs(again[:, 1]).max() < 0.15
 
 
+def test_a_goal_beyond_the_grid_whose_border_cell_is_a_wall_stands_in_beside_it():
+    """A goal beyond the window is taken at the border cell nearest it; where that cell
+    is in a wall (a known map's wall at the window's edge) the field leads to the free
+    cell nearest it within BORDER_SLACK, not nowhere."""
+    occ = np.zeros((60, 60), bool)
+    occ[25:36, 57:] = True   # a wall against the right border, rows 25-35
+    far = (20.0, 30 * RES + 0.5 * RES)   # beyond the right edge, level with the wall
+    field = field_on(occ, far, robot=(0.5, 1.5), inflation=0.1)
+    assert field is not None and field.reachable((0.5, 1.5))
+    end = field.path((0.5, 1.5))[-1]
+    assert end[0] > 50 * RES and abs(end[1] - far[1]) <= 1.0 + RES
+    assert field_on(occ, (2.9, far[1]), robot=(0.5, 1.5), inflation=0.1) is None   # inside
+
+
 def test_goal_in_an_inflated_obstacle_has_no_field():
     occ = np.zeros((60, 60), bool)
     occ[30, 30] = True

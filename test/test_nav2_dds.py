@@ -5,6 +5,7 @@ managed node driven through its lifecycle services as nav2_lifecycle_manager dri
 it. sim_node closes the loop on an open floor."""
 
 import json
+import os
 import queue
 import subprocess
 import sys
@@ -14,7 +15,7 @@ from conftest import PARAMS, REPO, wait_for, with_paths
 from geometry_msgs.msg import PoseStamped, TwistStamped
 from lifecycle_msgs.msg import Transition
 from lifecycle_msgs.srv import ChangeState, GetState
-from nav_msgs.msg import Odometry
+from nav_msgs.msg import Odometry, Path
 import numpy as np
 import pytest
 import rclpy
@@ -23,6 +24,8 @@ from std_msgs.msg import String
 
 from subapf_planner.ros.conversions import pose_from_odom
 from subapf_planner.ros.processes import join_domain, start, stop
+from subapf_planner.sim.solvability import geodesic_length
+from subapf_planner.sim.world import load_world
 
 pytestmark = pytest.mark.dds
 
@@ -46,10 +49,10 @@ class Graph:
     a navigate_to_pose client process (nav2_client.py) fed one task at a time."""
 
     def __init__(self, domain: int, tmp_path, nav2_paths: dict, planner='planner_node',
-                 planner_args=()):
+                 planner_args=(), world_text=WORLD, sim_args=()):
         self.log_dir = tmp_path
-        world = tmp_path / 'open_floor.yaml'
-        world.write_text(WORLD)
+        world = tmp_path / 'world.yaml'
+        world.write_text(world_text)
         self.env = with_paths(join_domain(domain), nav2_paths)
         self.context = rclpy.Context()
         rclpy.init(context=self.context)
@@ -66,9 +69,12 @@ class Graph:
             (m.twist.linear.x, m.twist.angular.z)), 100)
         self.node.create_subscription(String, '/subapf_planner/status',
                                       lambda m: self.states.append(m.data), 100)
+        self.plans: list = []   # ~/plan as (k, 2) arrays in odom
+        self.node.create_subscription(Path, '/subapf_planner/plan', lambda m: self.plans.append(
+            np.array([(q.pose.position.x, q.pose.position.y) for q in m.poses])), 100)
         self.children = [
-            start('sim_node', ['-p', f'world:={world}', '-p', f'rate:={RATE}'], self.env,
-                  log=tmp_path / 'sim.log'),
+            start('sim_node', ['-p', f'world:={world}', '-p', f'rate:={RATE}', *sim_args],
+                  self.env, log=tmp_path / 'sim.log'),
             start(planner, ['--params-file', str(PARAMS), '-p', 'use_sim_time:=true',
                             *planner_args], self.env, log=tmp_path / 'planner.log')]
         self.client = None
@@ -278,3 +284,51 @@ def test_the_managed_planner_goes_through_its_states_as_nav2s_lifecycle_manager_
     assert lc.transition(Transition.TRANSITION_UNCONFIGURED_SHUTDOWN)
     assert lc.state() == 'finalized'
     assert 'Traceback' not in (graph.log_dir / 'planner.log').read_text()
+
+
+#: A room with a wall across it, its door at the top; the robot starts nearer the
+#: bottom, where the wall meets the room's wall beyond the lidar's reach: without the
+#: map the bottom looks the shorter way round (the shortest way 11 m).
+ROOM = """\
+name: door_in_a_wall
+start: [0.0, -1.5, 0.0]
+goal: [4.0, -1.5]
+time_limit: 150
+bounds: [-1.0, -4.0, 5.0, 5.0]
+obstacles:
+  - box: {center: [2.0, -0.25], size: [0.1, 7.5]}
+  - box: {center: [2.0, 4.75], size: [0.1, 0.5]}
+"""
+
+
+@pytest.fixture
+def with_map(ros_env, tmp_path, nav2_msgs_built, tf2_msgs_built):
+    paths = {k: os.pathsep.join(filter(None, [nav2_msgs_built.get(k), tf2_msgs_built.get(k)]))
+             for k in {*nav2_msgs_built, *tf2_msgs_built}}
+    g = Graph(int(ros_env['ROS_DOMAIN_ID']), tmp_path, paths, world_text=ROOM,
+              sim_args=['-p', 'publish_map:=true'])
+    yield g
+    g.close()
+
+
+def test_with_the_map_a_goal_behind_a_door_is_driven_to_by_the_door_at_once(with_map):
+    """The simulator publishes the world's map and map -> odom as map_server and a
+    localiser would; the planner starts its memory from them, and a goal in map, behind
+    a wall, is driven to through the wall's door without first driving at the wall: a
+    path near the shortest."""
+    graph = with_map
+    graph.until(lambda: 'memory started from the map' in (
+        graph.log_dir / 'planner.log').read_text(), 60, 'the planner taking the map')
+    graph.plans.clear()
+    [done] = graph.ask('goal 4.0 -1.5 map')
+    assert done['status'] == 'SUCCEEDED', (done, graph.logs())
+    assert near(graph, (4.0, -1.5)) < AT_GOAL
+    track = np.array(graph.track)
+    driven = float(np.sum(np.hypot(*np.diff(track, axis=0).T)))
+    shortest = geodesic_length(load_world(graph.log_dir / 'world.yaml'), radius=0.105)
+    assert driven < 1.15 * shortest, (driven, shortest)
+    # the first plan, from the start, went through the door (at y 3.5-4.5): the map's
+    # (without it the first plan goes round the end of the wall the lidar sees)
+    first = next(p for p in graph.plans if len(p))
+    crossing = first[np.argmin(np.abs(first[:, 0] - 2.0))]
+    assert 3.4 < crossing[1] < 4.6, first

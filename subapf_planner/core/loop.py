@@ -212,6 +212,11 @@ class DecisionLoop:
         the map frame's in the memory's frame); None: from the scans alone."""
         self.planner.know(known)
 
+    def start_from(self, known: KnownMap, odom_in_map) -> None:
+        """Start afresh from a localiser's map and its map -> odom (Planner.start_from):
+        goals in the memory's frame are then in the map's; the goal is kept."""
+        self.planner.start_from(known, odom_in_map)
+
     def cancel(self, reason: str = 'goal canceled') -> None:
         """Drop the goal (canceled, or the node deactivated): idle, for ``reason``, until
         the next goal; the planner's last command is forgotten, the memory stays."""

@@ -46,6 +46,9 @@ from .occupancy import cell_index
 MIN_SPEED = 0.02
 #: Free border kept around the box the field is computed on [m].
 CROP_MARGIN = 1.0
+#: A goal beyond the grid stands in at the border cell nearest it; when that cell is in
+#: a wall (a known map's), at the free cell nearest it within this [m].
+BORDER_SLACK = 1.0
 #: The 8 neighbours (d_row, d_col) and their lengths in cells.
 NEIGHBOURS = np.array([(-1, -1), (-1, 0), (-1, 1), (0, -1), (0, 1), (1, -1), (1, 0), (1, 1)])
 NEIGHBOUR_LENGTH = np.hypot(NEIGHBOURS[:, 0], NEIGHBOURS[:, 1])
@@ -274,7 +277,8 @@ def compute_field(occupied: NDArray[np.bool_], origin: ArrayLike, resolution: fl
     its fastest cell (a narrow gap keeps its speed). Reachability stays decided on
     the map's cells; if the blocks cut the robot off from a goal those cells reach
     (a gap narrower than a block or two), the field is marched on the cells instead.
-    ``goal`` outside the grid is replaced by the nearest cell of the grid's border.
+    ``goal`` outside the grid is replaced by the nearest cell of the grid's border (or
+    the free cell nearest that within BORDER_SLACK).
     ``inflation_radius`` [m]: the hard inflation (the robot's footprint; see the module
     docstring) and ``clearance_band`` [m] the band beyond it where travel speeds up.
     ``route`` (k, 2) [m]: the way the robot has taken (the last field's ``path``); travel
@@ -298,6 +302,8 @@ def compute_field(occupied: NDArray[np.bool_], origin: ArrayLike, resolution: fl
                        [h - 1, w - 1])
 
     gc, rc = cell(g), cell(robot)
+    beyond = not np.array_equal(gc, cell_index(g, origin, resolution)[0])
+    slack = max(goal_slack, BORDER_SLACK) if beyond else goal_slack
     margin = int(math.ceil((CROP_MARGIN + inflation_radius + clearance_band) / resolution))
     r0, r1, c0, c1 = crop_box(occupied, np.array([gc, rc]), margin)
     occ = occupied[r0:r1, c0:c1]
@@ -306,7 +312,7 @@ def compute_field(occupied: NDArray[np.bool_], origin: ArrayLike, resolution: fl
     clear = ndimage.distance_transform_edt(~occ) * resolution if occ.any() \
         else np.full(occ.shape, np.inf)
     free = clear >= inflation_radius
-    g_local = nearest_free(free, (gc[0] - r0, gc[1] - c0), goal_slack / resolution)
+    g_local = nearest_free(free, (gc[0] - r0, gc[1] - c0), slack / resolution)
     if g_local is None:
         return None
     moved = g_local != (gc[0] - r0, gc[1] - c0)

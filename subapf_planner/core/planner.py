@@ -322,6 +322,15 @@ class Planner:
         frame in it; None: none): NavigationMemory.know."""
         self.memory.know(known)
 
+    def start_from(self, known: KnownMap, odom_in_map: ArrayLike) -> None:
+        """Start afresh from a localiser's map: the memory's frame becomes the map's
+        frame, odom placed in it at ``odom_in_map`` (x, y, yaw: the localiser's map ->
+        odom), the memory taken from ``known`` (in that frame) and what it held before
+        dropped (placed in another frame); the scan alignment goes on from there."""
+        self.forget()
+        self.correction = tuple(float(v) for v in odom_in_map)
+        self.memory.know(known)
+
     def follow(self, path: ArrayLike | None, in_map: bool = False) -> None:
         """Favour ``path`` (k, 2) [m] in the navigation field (path_discount) until the
         next call; None: no path. A path in odom (``in_map`` False) is anchored as a goal

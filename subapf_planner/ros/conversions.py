@@ -13,6 +13,7 @@ import numpy as np
 from sensor_msgs.msg import LaserScan
 
 from ..bag.events import stamp_ns
+from ..core.known_map import KnownMap, KnownMapError
 from ..core.occupancy import OccupancyGrid
 from ..core.robot import compose
 from ..core.scan import Scan
@@ -211,4 +212,34 @@ def path_to_msg(points: np.ndarray, frame: str, stamp: Time) -> Path:
         pose.pose.orientation.z = math.sin(0.5 * yaw)
         pose.pose.orientation.w = math.cos(0.5 * yaw)
         msg.poses.append(pose)
+    return msg
+
+
+def known_map_from_msg(msg: GridMsg) -> KnownMap:
+    """A nav_msgs/OccupancyGrid (map_server's, slam_toolbox's) as a KnownMap in its own
+    frame (the origin's yaw kept); KnownMapError when it is malformed."""
+    info = msg.info
+    n = info.width * info.height
+    if n == 0 or len(msg.data) != n:
+        raise KnownMapError(f'map of {info.width} x {info.height} cells with '
+                            f'{len(msg.data)} values')
+    cells = np.asarray(msg.data, np.int8).reshape(info.height, info.width)
+    o = info.origin
+    yaw = yaw_from_quaternion(o.orientation.x, o.orientation.y, o.orientation.z,
+                              o.orientation.w)
+    return KnownMap(cells, (0.0, 0.0), float(info.resolution),
+                    pose=(float(o.position.x), float(o.position.y), float(yaw)))
+
+
+def known_map_to_msg(known: KnownMap, frame: str, stamp: Time) -> GridMsg:
+    """A KnownMap placed at the identity as nav_msgs/OccupancyGrid in ``frame``."""
+    msg = GridMsg()
+    msg.header.frame_id = frame
+    msg.header.stamp = stamp
+    h, w = np.shape(known.cells)
+    msg.info.resolution = float(known.resolution)
+    msg.info.width, msg.info.height = int(w), int(h)
+    msg.info.origin.position.x, msg.info.origin.position.y = map(float, known.origin)
+    msg.info.origin.orientation.w = 1.0
+    msg.data = array.array('b', np.ascontiguousarray(known.cells, np.int8).tobytes())
     return msg

@@ -25,6 +25,7 @@ decisions are subapf_planner.core.loop's, the input checks ros/intake.py's.
 from __future__ import annotations
 
 from dataclasses import dataclass
+import math
 import sys
 
 from geometry_msgs.msg import PoseStamped, TransformStamped, Twist, TwistStamped
@@ -50,12 +51,20 @@ from ..core.config import (
     beyond_robot_text,
     clamp_to_robot,
 )
+from ..core.known_map import KnownMapError
 from ..core.loop import DecisionLoop, Supervision
 from ..core.navigation import thin_polyline
 from ..core.params import check_fields, param
 from ..core.robot import ROBOTS, RobotDescription, chain, invert, to_parent
 from .actions import navigation_actions
-from .conversions import cmd_to_msg, grid_to_msg, path_to_msg, planar_transform, transform_msg
+from .conversions import (
+    cmd_to_msg,
+    grid_to_msg,
+    known_map_from_msg,
+    path_to_msg,
+    planar_transform,
+    transform_msg,
+)
 from .intake import Intake
 from .markers import markers_from_result
 from .parameters import declare, read, warn_undeclared
@@ -77,6 +86,8 @@ SILENCE_CHECK = 2.0
 #: Odometry queued between two ticks (taken at the tick, not on arrival): 2.5 s at 20 Hz,
 #: 10 planning periods of the default.
 ODOM_QUEUE = 50
+#: /tf messages queued between two ticks (taken at the tick, for map -> odom).
+TF_QUEUE = 100
 
 
 #: The value of the ``robot`` parameter for a robot of one's own (limits not checked).
@@ -117,6 +128,13 @@ class NodeOptions:
                             'read from /tf_static as this frame -> laser_frame when it is '
                             'there (else laser_x, laser_y, laser_yaw)', read_only=True)
     odom_frame: str = param('odom', 'Frame of odometry and goals')
+    use_map: bool = param(True, 'Start the memory from a map the robot already has: once a '
+                          'map is on map (nav_msgs/OccupancyGrid, transient local: '
+                          "map_server's, slam_toolbox's) and map_frame -> odom_frame on /tf "
+                          "(a localiser's), the memory's frame becomes the map's and the "
+                          'memory starts from the map (a newer map: its cells again); '
+                          'docs/nav2.md',
+                          read_only=True)
     map_frame: str = param('map', "Name of the memory's frame (odom as it was at the start, "
                            'kept still by scan_alignment): goals may be given in it, and '
                            '~/correction is its transform to odom_frame (a topic, not /tf: '
@@ -198,6 +216,7 @@ class PlannerParts:
         self._links: dict[str, tuple[str, tuple[float, float, float], bool]] = {}
         self._tf_mount: tuple[float, float, float] | None = None
         self._setup_tf_static()
+        self._setup_known_map()
         self._last_state = ''
         self.timer = None
         jump = self.get_clock().create_jump_callback(
@@ -313,6 +332,66 @@ class PlannerParts:
         self._subscription(TFMessage, '/tf_static', self._on_tf_static, LATCHED)
         self.get_logger().info(f'laser mounting from parameters {self.ctl.cfg.laser_mount} '
                                f'until /tf_static gives {o.base_frame} -> {o.laser_frame}')
+
+    # --- a map the robot already has ---------------------------------------------------
+    def _setup_known_map(self) -> None:
+        """``map`` and /tf (polled at the tick) when use_map and tf2_msgs are there."""
+        self._known_msg = None   # the newest map not yet taken, ...
+        self._odom_in_map: tuple[float, float, float] | None = None   # ... the localiser's
+        self._map_taken = False   # the memory's frame is the map's
+        self._tf_inputs = ()
+        if not self.options.use_map:
+            return
+        try:
+            from tf2_msgs.msg import TFMessage
+        except ImportError:
+            self.get_logger().info('map not used (tf2_msgs not installed: no map -> odom)')
+            return
+        self._subscription(GridMsg, 'map', self._on_map, LATCHED)
+        self._tf_inputs = (self._subscription(TFMessage, '/tf', lambda _: None,
+                                              QoSProfile(depth=TF_QUEUE),
+                                              callback_group=PolledGroup()),)
+
+    def _on_map(self, msg: GridMsg) -> None:
+        self._known_msg = msg
+
+    def _take_known_map(self) -> None:
+        """The localiser's newest map -> odom from /tf; then a new map, if one came, as the
+        memory's start (DecisionLoop.start_from)."""
+        o = self.options
+        for sub in self._tf_inputs:
+            with sub.handle:
+                while (taken := sub.handle.take_message(sub.msg_type, sub.raw)) is not None:
+                    for t in taken[0].transforms:
+                        pose = planar_transform(t)[2]
+                        if t.header.frame_id == o.map_frame \
+                                and t.child_frame_id == o.odom_frame \
+                                and all(map(math.isfinite, pose)):
+                            self._odom_in_map = pose
+        if self._known_msg is None or self._odom_in_map is None:
+            return
+        msg, self._known_msg = self._known_msg, None
+        if msg.header.frame_id not in ('', o.map_frame):
+            self.get_logger().warn(f'map in frame "{msg.header.frame_id}", not '
+                                   f'"{o.map_frame}": not used')
+            return
+        try:
+            known = known_map_from_msg(msg)
+        except KnownMapError as exc:
+            self.get_logger().warn(f'map not used: {exc}')
+            return
+        h, w = known.cells.shape
+        if self._map_taken:   # a newer map (slam_toolbox's): the cells taken again
+            self.ctl.know(known)
+            self.get_logger().info(f'memory taken again from a new map ({w} x {h} cells)')
+            return
+        self._map_taken = True
+        self.ctl.start_from(known, self._odom_in_map)
+        x, y, yaw = self._odom_in_map
+        self.get_logger().info(f'memory started from the map ({w} x {h} cells of '
+                               f'{known.resolution:g} m), {o.map_frame} -> {o.odom_frame} '
+                               f'({x:.2f}, {y:.2f}, {yaw:.3f} rad): goals in '
+                               f'"{o.map_frame}" are in the map')
 
     def _on_tf_static(self, msg) -> None:
         for t in msg.transforms:
@@ -454,6 +533,7 @@ class PlannerParts:
     def _on_timer(self) -> None:
         if self.actions is not None:
             self.actions.before_tick()   # a cancel request first: no command after it
+        self._take_known_map()
         tick = self.get_clock().now()
         later = self._take_arrived_inputs(tick.nanoseconds)
         self._explain_silence(tick.nanoseconds * 1e-9)

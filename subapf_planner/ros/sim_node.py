@@ -23,6 +23,7 @@ from dataclasses import dataclass
 import sys
 
 from geometry_msgs.msg import PoseStamped, Twist, TwistStamped
+from nav_msgs.msg import OccupancyGrid as GridMsg
 from nav_msgs.msg import Odometry
 import numpy as np
 from rclpy.node import Node
@@ -33,12 +34,15 @@ from std_msgs.msg import String
 from visualization_msgs.msg import MarkerArray
 
 from ..core.params import ConfigError, check_fields, param
+from ..core.robot import compose, invert
 from ..sim.attempt import Attempts
 from ..sim.faults import FAULT_SEED_OFFSET, ScanDelivery, ScanFaults, delivery_faults
 from ..sim.simulator import ROBOT, BurgerSim, SimConfig
+from ..sim.solvability import world_map
 from ..sim.world import WorldError, load_world
 from .conversions import (
     cmd_from_msg,
+    known_map_to_msg,
     odom_to_msg,
     scan_to_msg,
     seconds_to_stamp,
@@ -72,6 +76,17 @@ class SimNodeOptions:
                         read_only=True)
     enable_stamped_cmd_vel: bool = param(True, 'Subscribe TwistStamped (true) or Twist',
                                          read_only=True)
+    publish_map: bool = param(False, "Publish the world's map on map (nav_msgs/OccupancyGrid, "
+                              'transient local: its static obstacles at 0.05 m, as map_server '
+                              'would) and, with tf2_msgs, map -> odom on /tf at the scan rate, '
+                              'as a localiser would: where odom truly is in the world, with '
+                              'map_error_x/y/yaw added', read_only=True)
+    map_error_x: float = param(0.0, "The localiser's error in map -> odom (x)", 'm', -10.0,
+                               10.0, read_only=True)
+    map_error_y: float = param(0.0, "The localiser's error in map -> odom (y)", 'm', -10.0,
+                               10.0, read_only=True)
+    map_error_yaw: float = param(0.0, "The localiser's error in map -> odom (yaw)", 'rad',
+                                 -3.15, 3.15, read_only=True)
 
     def __post_init__(self) -> None:
         check_fields(self)
@@ -107,6 +122,11 @@ class SimNode(Node):
         self.moving_pub = self.create_publisher(MarkerArray, 'moving_obstacles', 10) \
             if self.world.moving else None
         self._setup_tf()
+        self._map_error = (options.map_error_x, options.map_error_y, options.map_error_yaw) \
+            if options.publish_map else None
+        if options.publish_map:
+            self.create_publisher(GridMsg, 'map', LATCHED).publish(
+                known_map_to_msg(world_map(self.world), 'map', seconds_to_stamp(0.0)))
         cmd_type = TwistStamped if options.enable_stamped_cmd_vel else Twist
         self.create_subscription(cmd_type, 'cmd_vel', self._on_cmd, 10)
         self.create_subscription(PoseStamped, 'goal_pose', self._on_goal, 10)
@@ -173,6 +193,13 @@ class SimNode(Node):
             self._scans.capture(scan_to_msg(sweep, 'base_scan'), sim.sweep_end(sweep))
         if t + 1e-9 >= self._next_scan:
             self._next_scan += SCAN_PERIOD
+            if self._map_error is not None and self.tf_pub is not None:
+                # odom in the world (the map), as a localiser finds it, with its error
+                odom_in_map = compose(self._map_error,
+                                      compose(sim.true_pose(), invert(pose)))
+                self.tf_pub.publish(self._tf_message(transforms=[transform_msg(
+                    'map', 'odom', (odom_in_map[0], odom_in_map[1], 0.0), odom_in_map[2],
+                    t)]))
             if self.moving_pub is not None and listened(self.moving_pub):
                 # where they truly are, at the scan rate
                 self.moving_pub.publish(moving_obstacle_markers(

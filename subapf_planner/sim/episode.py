@@ -18,6 +18,7 @@ import time
 import numpy as np
 
 from ..core.config import PlannerConfig
+from ..core.known_map import KnownMap
 from ..core.loop import DecisionLoop, Supervision
 from ..core.scan import Scan
 from ..core.status import Outcome, State
@@ -104,18 +105,22 @@ class EpisodeResult:
 
 def run_episode(world: World, cfg: PlannerConfig, sim_cfg: SimConfig | None = None,
                 time_limit: float | None = None, faults: ScanFaults | None = None,
-                limits: Supervision | None = None, label: str | None = None) -> EpisodeResult:
+                limits: Supervision | None = None, label: str | None = None,
+                known_map: KnownMap | None = None) -> EpisodeResult:
     """Drive the world's start to its goal until the planner stops there by its own
     estimate (``reached`` when the truth is inside the world's tolerance then,
     ``missed`` when it is not: outcome_of), gives the goal up (``abandoned``: the
     progress checker; ``unreachable``: no way through its memory for
     ``unreachable_timeout``), collides or runs out of time. ``label`` names the method
-    in the result (default ``cfg.method``)."""
+    in the result (default ``cfg.method``). ``known_map``: the memory starts from it
+    (sim/solvability.world_map: the world's static obstacles)."""
     sim_cfg = sim_cfg or SimConfig()
     delivery: ScanDelivery[Scan] = ScanDelivery(delivery_faults(sim_cfg, faults),
                                                 sim_cfg.seed + FAULT_SEED_OFFSET)
     cfg = cfg.replace(goal_tolerance=min(cfg.goal_tolerance, world.goal_tolerance))
     ctl = DecisionLoop(cfg, limits)
+    if known_map is not None:
+        ctl.know(known_map)
     ctl.set_goal(np.asarray(world.goal, float), in_map=True)   # a place in the world
     path, times, plan_ms, recomputed, statuses, field_ms, after_ms = [], [], [], [], {}, [], []
     pose_error = []   # per planning cycle: the planned-from pose's distance to the truth

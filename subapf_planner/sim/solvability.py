@@ -20,6 +20,7 @@ from scipy import ndimage
 from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import dijkstra
 
+from ..core.known_map import KnownMap
 from ..core.robot import BURGER
 from .world import Box, Circle, Obstacle, World, parse_world
 
@@ -167,3 +168,20 @@ def bottleneck_width(world: World | dict[str, Any], resolution: float = 0.02) ->
         else:
             hi = mid - 1
     return 2.0 * float(levels[lo]) if lo >= 0 else 0.0
+
+
+#: Cell of a world's map (map_server's usual 0.05 m) [m].
+MAP_RESOLUTION = 0.05
+
+
+def world_map(world: World, resolution: float = MAP_RESOLUTION) -> KnownMap:
+    """The world's static obstacles as a map the robot already has (what SLAM or
+    map_server would give; core/known_map.py): cells whose centre is within half a cell
+    of an obstacle occupied (100), the rest of the bounds (without bounds: the
+    obstacles, start and goal plus 1 m) free (0), in the world's frame, placed at the
+    memory's origin (the memory's frame is odom at the start, which the simulator puts
+    at the world's origin)."""
+    dist, xs, ys = distance_field(world, resolution, cap=resolution)
+    cells = np.where(dist < 0.5 * resolution, 100, 0).astype(np.int8)
+    return KnownMap(cells, (float(xs[0] - 0.5 * resolution), float(ys[0] - 0.5 * resolution)),
+                    resolution)

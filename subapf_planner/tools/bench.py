@@ -40,7 +40,7 @@ from ..ros.paths import default_params_file, shipped_worlds_dir
 from ..sim.episode import run_episode
 from ..sim.faults import ScanFaults
 from ..sim.simulator import SimConfig
-from ..sim.solvability import geodesic_length
+from ..sim.solvability import geodesic_length, world_map
 from ..sim.world import World, WorldError, load_world, world_files
 from .animation import animate_run
 from .metrics import barn_score
@@ -125,13 +125,14 @@ def parse_method(spec: str) -> dict:
 
 def _run_world(job: tuple) -> list[tuple[dict, list]]:
     """All methods on one world (in a worker), and its plot when ``plot_dir`` is set."""
-    world, methods, cfg, sim_cfg, faults, plot_dir, animate = job
+    world, methods, cfg, sim_cfg, faults, plot_dir, animate, known = job
     out = []
     shortest = shortest_path(world)
     for spec in methods:
         run_cfg = cfg.replace(**parse_method(spec))
         label = f'{run_cfg.method}:{run_cfg.attraction_field}'
-        result = run_episode(world, run_cfg, sim_cfg, faults=faults, label=label)
+        result = run_episode(world, run_cfg, sim_cfg, faults=faults, label=label,
+                             known_map=world_map(world) if known else None)
         out.append((efficiency(result.metrics(world), shortest, run_cfg.max_linear_velocity),
                     result.path[:, :2].round(4).tolist()))
     if plot_dir is not None:
@@ -361,6 +362,9 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
     p.add_argument('--faults', action='store_true',
                    help='the four faults on top of the sensor: --noise 0.03 --beam-dropout 0.2 '
                    '--scan-dropout 0.2 --scan-latency 0.1 (each still settable)')
+    p.add_argument('--known-map', action='store_true',
+                   help="start each run's memory from the world's map (its static "
+                   'obstacles at 0.05 m, as map_server gives one; docs/nav2.md)')
     p.add_argument('--no-plots', action='store_true', help='skip the PNGs')
     p.add_argument('--animate', action='store_true',
                    help="also write an animated GIF of each world's runs")
@@ -400,7 +404,7 @@ def main(argv: list[str] | None = None) -> int:
     plot_dir = None if args.no_plots else str(out)
     # on a cluster the workers' disks are not ours: the plots are drawn here
     worker_plots = None if args.cluster else plot_dir
-    jobs = [(w, methods, cfg, sim_cfg, faults, worker_plots, args.animate)
+    jobs = [(w, methods, cfg, sim_cfg, faults, worker_plots, args.animate, args.known_map)
             for w in worlds.values()]
     t0 = time.perf_counter()
     try:
