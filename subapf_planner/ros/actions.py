@@ -40,6 +40,7 @@ from rclpy.action import ActionServer, CancelResponse, GoalResponse
 from rclpy.duration import Duration
 from rclpy.task import Future
 
+from ..core.memory import SAME_GOAL
 from ..core.status import State
 from .conversions import pose_msg
 
@@ -132,7 +133,7 @@ class NavigationActions:
         if goal is None or not path.poses:
             return False
         end = path.poses[-1].pose.position
-        return bool(np.hypot(end.x - goal[0], end.y - goal[1]) < 0.05)
+        return bool(np.hypot(end.x - goal[0], end.y - goal[1]) < SAME_GOAL)
 
     async def _execute(self, handle):
         key = bytes(handle.goal_id.uuid)
