@@ -19,8 +19,6 @@ import math
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from .robot import to_parent
-
 #: map_server's thresholds (Nav2's defaults, occupied_thresh 0.65, free_thresh 0.25):
 #: a cell at or above OCCUPIED_AT is a wall, one at or below FREE_AT free, between them
 #: and -1 unknown.
@@ -72,14 +70,6 @@ class KnownMap:
         out = np.full(len(p), -1, np.int8)
         out[inside] = np.asarray(self.cells)[rows[inside], cols[inside]]
         return out
-
-    def corners(self) -> NDArray[np.float64]:
-        """The map's four corners in the memory's frame (4, 2) [m]."""
-        h, w = np.shape(self.cells)
-        ox, oy = self.origin
-        r = self.resolution
-        return to_parent(self.pose, [(ox, oy), (ox + w * r, oy), (ox + w * r, oy + h * r),
-                                     (ox, oy + h * r)])
 
 
 def prior(known: KnownMap, centres: ArrayLike) -> tuple[NDArray[np.float32],

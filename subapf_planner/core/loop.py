@@ -212,7 +212,7 @@ class DecisionLoop:
         the map frame's in the memory's frame); None: from the scans alone."""
         self.planner.know(known)
 
-    def start_from(self, known: KnownMap, odom_in_map) -> None:
+    def start_from(self, known: KnownMap, odom_in_map: tuple[float, float, float]) -> None:
         """Start afresh from a localiser's map and its map -> odom (Planner.start_from):
         goals in the memory's frame are then in the map's; the goal is kept."""
         self.planner.start_from(known, odom_in_map)
