@@ -223,6 +223,29 @@ def wait_for(predicate: Callable[[], _T], timeout: float, what: str | Callable[[
         time.sleep(interval)
 
 
+class ChildGraph:
+    """A test's own node, spun on ``ex``, beside child processes ``children`` whose
+    logs are the *.log files of ``log_dir``: what the DDS tests' graphs share."""
+
+    ex: object
+    children: list
+    log_dir: Path
+
+    def logs(self) -> str:
+        """The end of each child's log."""
+        return '\n'.join(f'--- {f.name}\n' + f.read_text()[-3000:]
+                         for f in sorted(self.log_dir.glob('*.log')))
+
+    def until(self, predicate, timeout: float, what: str):
+        """Spin until ``predicate`` holds (wait_for), failing with the logs, or at once
+        when a child has died."""
+        def spun():
+            self.ex.spin_once(timeout_sec=0.05)
+            assert all(c.poll() is None for c in self.children), self.logs()
+            return predicate()
+        return wait_for(spun, timeout, lambda: f'{what}\n{self.logs()}', interval=0.0)
+
+
 def colour_pixels(png: Path, colour: str, tol: float = 30.0) -> int:
     """How many pixels of the image ``png`` have the matplotlib ``colour`` (each RGB
     channel within ``tol`` of it, on 0-255)."""

@@ -6,7 +6,7 @@ task, each answer one JSON line on stdout:
   goal X Y [FRAME]        send, wait for the result
   path X0 Y0 X1 Y1 ...    follow_path through these points (odom), wait for the result
   preempt X1 Y1 X2 Y2     send the first, once it has feedback send the second
-  cancel X Y S            send, after S seconds of feedback cancel, wait for the result
+  cancel X Y D            send, once the distance left fell by D metres cancel, wait
 
 An answer: {"results": [{"status": "SUCCEEDED" | "ABORTED" | "CANCELED", "error_code",
 "error_msg", "feedback": [{"t", "distance_remaining", "navigation_time",
@@ -111,10 +111,11 @@ def preempt(client: Client, x1, y1, x2, y2) -> list[dict]:
     return [client.finish(first), client.finish(second)]
 
 
-def cancel(client: Client, x, y, seconds) -> list[dict]:
+def cancel(client: Client, x, y, metres) -> list[dict]:
     record = client.send(x, y)
     fb = record['feedback']
-    client.spin_until(lambda: fb and fb[-1]['t'] - fb[0]['t'] >= float(seconds))
+    client.spin_until(lambda: fb and max(f['distance_remaining'] for f in fb)
+                      - fb[-1]['distance_remaining'] >= float(metres))
     canceling = record['handle'].cancel_goal_async()
     client.spin_until(canceling.done)
     return [client.finish(record)]

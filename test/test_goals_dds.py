@@ -8,7 +8,7 @@ import subprocess
 import sys
 import time
 
-from conftest import PARAMS, REPO, wait_for
+from conftest import PARAMS, REPO, ChildGraph
 from geometry_msgs.msg import PoseStamped
 from nav_msgs.msg import Odometry
 import numpy as np
@@ -37,7 +37,7 @@ obstacles:
 RATE = 2.0
 
 
-class Graph:
+class Graph(ChildGraph):
     """sim_node and planner_node as child processes, and a node here that sends goals
     and hears the clock, the outcomes, the planner's states and the ground truth."""
 
@@ -71,17 +71,6 @@ class Graph:
 
     def _on_clock(self, msg):
         self.clock = stamp_to_seconds(msg.clock)
-
-    def logs(self) -> str:
-        return '\n'.join(f'--- {f.name}\n' + f.read_text()[-3000:]
-                         for f in sorted(self.log_dir.glob('*.log')))
-
-    def until(self, predicate, timeout: float, what: str):
-        def spun():
-            self.ex.spin_once(timeout_sec=0.05)
-            assert all(c.poll() is None for c in self.children), self.logs()
-            return predicate()
-        return wait_for(spun, timeout, lambda: f'{what}\n{self.logs()}', interval=0.0)
 
     def state(self) -> State | None:
         return parse_status(self.states[-1])[0] if self.states else None
@@ -168,7 +157,7 @@ def test_the_simulator_serves_goal_after_goal_after_reached_and_after_timeout(gr
 def readme_goal_script() -> str:
     """The rclpy script of the README's "Sending a goal" section."""
     text = (REPO / 'README.md').read_text()
-    section = text.split('### Sending a goal\n', 1)[1].split('\n## ', 1)[0]
+    section = re.split(r'\n##+ ', text.split('### Sending a goal\n', 1)[1], maxsplit=1)[0]
     scripts = re.findall(r'```python\n(.+?)\n```', section, re.S)
     assert len(scripts) == 1
     return scripts[0] + '\n'
