@@ -2,7 +2,10 @@
 
 Topics (relative, so namespaces and remapping work):
   in:  scan (sensor_msgs/LaserScan, sensor-data QoS), odom (nav_msgs/Odometry),
-       goal_pose (geometry_msgs/PoseStamped, in the odom frame or map_frame)
+       goal_pose (geometry_msgs/PoseStamped, in the odom frame or map_frame); with
+       use_map, map (nav_msgs/OccupancyGrid, transient local) and /tf's map_frame ->
+       odom_frame: a map the robot already has and its localiser
+  actions: navigate_to_pose, follow_path (nav2_msgs; ros/actions.py)
   out: cmd_vel (geometry_msgs/TwistStamped, or Twist with
        enable_stamped_cmd_vel:=false), ~/status (std_msgs/String,
        "state: reason"), ~/markers (visualization_msgs/MarkerArray),

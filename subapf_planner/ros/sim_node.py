@@ -15,6 +15,9 @@ served. Physics advances in steps of 50 ms of simulated time on a wall-clock tim
 tf2_msgs is installed (not among the PyPI ROS wheels; odom carries the same pose).
 A world with moving obstacles also gets ``moving_obstacles``
 (visualization_msgs/MarkerArray in odom: where each truly is, at the scan rate).
+With ``publish_map`` the world's map goes out on ``map`` (nav_msgs/OccupancyGrid,
+transient local) and, with tf2_msgs, ``map`` -> ``odom`` on /tf, as map_server and a
+localiser give them (with ``map_error_*`` added: a localiser's error).
 """
 
 from __future__ import annotations
