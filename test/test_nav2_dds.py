@@ -1,8 +1,9 @@
-"""The planner in a Nav2 system, over DDS: the navigate_to_pose action driven as
-nav2_simple_commander drives it (test/nav2_client.py, a process that can import
-nav2_msgs: built by conftest's nav2_msgs_built where no ROS install has it), and the
-managed node driven through its lifecycle services as nav2_lifecycle_manager drives
-it. sim_node closes the loop on an open floor."""
+"""The planner in a Nav2 system, over DDS: the navigate_to_pose and follow_path actions
+driven as nav2_simple_commander and Nav2's navigator drive them (test/nav2_client.py, a
+process that can import nav2_msgs: built by conftest's nav2_msgs_built where no ROS
+install has it), the managed node driven through its lifecycle services as
+nav2_lifecycle_manager drives it, and a map the robot already has (sim_node's map and
+map -> odom, tf2_msgs built as nav2_msgs is). sim_node closes the loop."""
 
 import json
 import os
@@ -29,7 +30,7 @@ from subapf_planner.sim.world import load_world
 
 pytestmark = pytest.mark.dds
 
-#: An open floor with one round obstacle (a goal inside it is occupied).
+#: An open floor with one round obstacle (a goal inside it is walled in).
 WORLD = """\
 name: open_floor
 start: [0.0, 0.0, 0.0]
