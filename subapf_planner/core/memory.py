@@ -33,7 +33,7 @@ from scipy import ndimage
 from .alignment import DistanceField, Match, align, distance_field
 from .config import PlannerConfig
 from .known_map import KnownMap
-from .navigation import NavigationField, compute_field, densify, nearest_free
+from .navigation import NavigationField, compute_field, nearest_free
 from .occupancy import ESTABLISHED, NOT_ESTABLISHED, OccupancyGrid
 from .robot import compose, to_parent
 from .scan import Scan
@@ -121,8 +121,8 @@ class NavigationMemory:
         #: goal key it leads to: the next field of that goal favours it (route_discount).
         self.route: NDArray[np.float64] | None = None
         self._route_goal: tuple | None = None
-        #: A path given to follow (x, y) (k, 2) in the memory's frame, points at most a
-        #: cell apart (follow): favoured by path_discount instead of the route taken.
+        #: A path given to follow (x, y) (k, 2) in the memory's frame (follow): favoured
+        #: by path_discount instead of the route taken.
         self.path: NDArray[np.float64] | None = None
         #: A map the robot already has, the grid's prior (know).
         self.known: KnownMap | None = None
@@ -231,7 +231,7 @@ class NavigationMemory:
         if path is None:
             self.path = None
         else:
-            self.path = densify(np.asarray(path, float).reshape(-1, 2), self.grid.resolution)
+            self.path = np.array(path, float).reshape(-1, 2)
             self.route, self._route_goal = None, None
         self._field_key = None
         self._drop_pending()

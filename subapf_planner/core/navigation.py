@@ -371,10 +371,11 @@ def route_speed(speed: NDArray[np.float64], origin: ArrayLike, cell: float, rout
     along the way the robot has taken costs ``discount`` less, so another way takes over
     only when it is that much shorter (hysteresis between near-equal ways). Every speed
     stays positive and finite: the field is still a distance with one minimum, the goal.
-    Route points off the patch are left out."""
-    r = np.asarray(route, float).reshape(-1, 2)
+    The route is taken as a line (densify: a point at least every cell), whatever its
+    points' spacing (a global planner's path, the field's own descent); its parts off
+    the patch are left out."""
     h, w = speed.shape
-    cells = np.floor((r - np.asarray(origin, float)) / cell).astype(np.int64)[:, ::-1]
+    cells = cell_index(densify(route, cell), origin, cell)
     cells = cells[(cells[:, 0] >= 0) & (cells[:, 0] < h) & (cells[:, 1] >= 0)
                   & (cells[:, 1] < w)]
     if not len(cells) or not 0.0 < discount < 1.0:

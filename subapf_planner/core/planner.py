@@ -327,6 +327,7 @@ class Planner:
         frame, odom placed in it at ``odom_in_map`` (x, y, yaw: the localiser's map ->
         odom), the memory taken from ``known`` (in that frame) and what it held before
         dropped (placed in another frame); the scan alignment goes on from there."""
+        self.memory.know(None)   # (so that forget does not read the old map in first)
         self.forget()
         self.correction = tuple(float(v) for v in odom_in_map)
         self.memory.know(known)

@@ -72,7 +72,7 @@ from .intake import Intake
 from .markers import markers_from_result
 from .parameters import declare, read, warn_undeclared
 from .qos import LATCHED, listened, unheard_publishers
-from .spinning import SHUTDOWN_ACK_TIMEOUT, PolledGroup, spin_node
+from .spinning import SHUTDOWN_ACK_TIMEOUT, PolledGroup, spin_node, taken
 from .usage import node_usage
 
 NODE_NAME = 'subapf_planner'
@@ -342,7 +342,7 @@ class PlannerParts:
         self._known_msg = None   # the newest map not yet taken, ...
         self._odom_in_map: tuple[float, float, float] | None = None   # ... the localiser's
         self._map_taken = False   # the memory's frame is the map's
-        self._tf_inputs = ()
+        self._tf_sub = None
         if not self.options.use_map:
             return
         try:
@@ -351,9 +351,9 @@ class PlannerParts:
             self.get_logger().info('map not used (tf2_msgs not installed: no map -> odom)')
             return
         self._subscription(GridMsg, 'map', self._on_map, LATCHED)
-        self._tf_inputs = (self._subscription(TFMessage, '/tf', lambda _: None,
-                                              QoSProfile(depth=TF_QUEUE),
-                                              callback_group=PolledGroup()),)
+        self._tf_sub = self._subscription(TFMessage, '/tf', lambda _: None,
+                                          QoSProfile(depth=TF_QUEUE),
+                                          callback_group=PolledGroup())
 
     def _on_map(self, msg: GridMsg) -> None:
         self._known_msg = msg
@@ -362,15 +362,14 @@ class PlannerParts:
         """The localiser's newest map -> odom from /tf; then a new map, if one came, as the
         memory's start (DecisionLoop.start_from)."""
         o = self.options
-        for sub in self._tf_inputs:
-            with sub.handle:
-                while (taken := sub.handle.take_message(sub.msg_type, sub.raw)) is not None:
-                    for t in taken[0].transforms:
-                        pose = planar_transform(t)[2]
-                        if t.header.frame_id == o.map_frame \
-                                and t.child_frame_id == o.odom_frame \
-                                and all(map(math.isfinite, pose)):
-                            self._odom_in_map = pose
+        if self._tf_sub is None:
+            return
+        for msg in taken(self._tf_sub):
+            for t in msg.transforms:
+                pose = planar_transform(t)[2]
+                if t.header.frame_id == o.map_frame and t.child_frame_id == o.odom_frame \
+                        and all(map(math.isfinite, pose)):
+                    self._odom_in_map = pose
         if self._known_msg is None or self._odom_in_map is None:
             return
         msg, self._known_msg = self._known_msg, None
@@ -431,7 +430,8 @@ class PlannerParts:
         self.ctl.clock_jumped()   # (rcl re-arms the timer itself after a jump back)
 
     # --- inputs -----------------------------------------------------------------------
-    def _now(self) -> float:
+    def now_seconds(self) -> float:
+        """The node's clock [s]."""
         return self.get_clock().now().nanoseconds * 1e-9
 
     def _warn(self, problem: str | None) -> None:
@@ -439,27 +439,21 @@ class PlannerParts:
             self.get_logger().warn(problem, throttle_duration_sec=5.0)
 
     def _on_scan(self, msg: LaserScan) -> None:
-        self._warn(self.intake.scan(self.ctl, msg, self._now()))
+        self._warn(self.intake.scan(self.ctl, msg, self.now_seconds()))
 
     def _on_odom(self, msg: Odometry) -> None:
-        self._warn(self.intake.odom(self.ctl, msg, self._now()))
+        self._warn(self.intake.odom(self.ctl, msg, self.now_seconds()))
 
     def _on_goal(self, msg: PoseStamped) -> None:
         if not self.active:
             self.get_logger().warn('goal_pose ignored: the planner is not active')
             return
-        new, refused = self.intake.goal(self.ctl, msg)
-        if refused:
-            self.get_logger().error(refused)
-            return
-        if self.actions is not None:
+        if self.take_goal(msg) is None and self.actions is not None:
             self.actions.preempt('preempted by a goal on goal_pose')
-        if new:
-            self._took_goal()
 
     def take_goal(self, msg: PoseStamped | Path) -> str | None:
-        """A goal (a pose, or a path to follow to its end) from an action: taken (None),
-        or why it is refused."""
+        """A goal (a pose, or a path to follow to its end) from goal_pose or an action:
+        taken (None), or why it is refused (logged)."""
         new, refused = (self.intake.path if isinstance(msg, Path) else self.intake.goal)(
             self.ctl, msg)
         if refused:
@@ -480,9 +474,6 @@ class PlannerParts:
         self._last_state = self.ctl.text
         if listened(self.status_pub):
             self.status_pub.publish(String(data=self.ctl.text))
-
-    def now_seconds(self) -> float:
-        return self._now()
 
     def _set_goal(self, goal: np.ndarray) -> None:
         if self.ctl.set_goal(goal):
@@ -506,13 +497,11 @@ class PlannerParts:
         taken in after the tick."""
         later = []
         for sub, handler in self._inputs:
-            with sub.handle:
-                while (taken := sub.handle.take_message(sub.msg_type, sub.raw)) is not None:
-                    msg = taken[0]
-                    if stamp_ns(msg.header.stamp) <= tick_ns:
-                        handler(msg)
-                    else:
-                        later.append((handler, msg))
+            for msg in taken(sub):
+                if stamp_ns(msg.header.stamp) <= tick_ns:
+                    handler(msg)
+                else:
+                    later.append((handler, msg))
         return later
 
     def _explain_silence(self, now: float) -> None:

@@ -53,6 +53,14 @@ class PolledGroup(CallbackGroup):
         pass
 
 
+def taken(sub) -> Iterator:
+    """The messages queued in subscription ``sub`` of a PolledGroup, oldest first, each
+    taken from the queue as it is yielded."""
+    with sub.handle:
+        while (msg := sub.handle.take_message(sub.msg_type, sub.raw)) is not None:
+            yield msg[0]
+
+
 def stop_on_signals() -> threading.Event:
     """An event set by SIGINT or SIGTERM (instead of an exception, see spin_node)."""
     stop = threading.Event()

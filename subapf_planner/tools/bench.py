@@ -128,11 +128,12 @@ def _run_world(job: tuple) -> list[tuple[dict, list]]:
     world, methods, cfg, sim_cfg, faults, plot_dir, animate, known = job
     out = []
     shortest = shortest_path(world)
+    known_map = world_map(world) if known else None
     for spec in methods:
         run_cfg = cfg.replace(**parse_method(spec))
         label = f'{run_cfg.method}:{run_cfg.attraction_field}'
         result = run_episode(world, run_cfg, sim_cfg, faults=faults, label=label,
-                             known_map=world_map(world) if known else None)
+                             known_map=known_map)
         out.append((efficiency(result.metrics(world), shortest, run_cfg.max_linear_velocity),
                     result.path[:, :2].round(4).tolist()))
     if plot_dir is not None:
