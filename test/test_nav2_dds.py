@@ -104,10 +104,16 @@ class Graph(ChildGraph):
             self.answers.put(line)
 
     def close(self):
-        if self.client is not None:
-            self.client.stdin.close()
-            self.client.wait(timeout=10)
-        stop(self.children)
+        try:
+            if self.client is not None:   # stdin closed: it ends (killed if it hangs)
+                self.client.stdin.close()
+                try:
+                    self.client.wait(timeout=10)
+                except subprocess.TimeoutExpired:
+                    self.client.kill()
+                    self.client.wait()
+        finally:
+            stop(self.children)
         self.node.destroy_node()
         rclpy.try_shutdown(context=self.context)
 
