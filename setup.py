@@ -72,7 +72,6 @@ setup(
     name=PACKAGE,
     version='0.9.0',
     packages=find_packages(exclude=['test']),
-    package_data={PACKAGE + '.sim': ['urdf/*.urdf']},
     data_files=[
         ('share/ament_index/resource_index/packages', ['resource/' + PACKAGE]),
         ('share/' + PACKAGE, ['package.xml']),

@@ -13,7 +13,7 @@ from launch_ros.actions import Node
 from launch_ros.substitutions import FindPackageShare
 
 PACKAGE = 'subapf_planner'
-ROBOTS = ['burger', 'waffle_pi', 'turtlebot4']
+ROBOTS = ['burger', 'waffle_pi', 'turtlebot4', 'jackal']
 
 
 def generate_launch_description() -> LaunchDescription:

@@ -183,7 +183,7 @@ def test_the_scan_goes_into_the_memory_after_the_command_the_same_either_way():
     drifting odometry through a cluttered field."""
     from subapf_planner.core.loop import DecisionLoop
     from subapf_planner.ros.paths import shipped_worlds_dir
-    from subapf_planner.sim.simulator import BurgerSim, SimConfig
+    from subapf_planner.sim.simulator import RobotSim, SimConfig
     from subapf_planner.sim.world import load_world
     world = load_world(shipped_worlds_dir() / 'cluttered_field.yaml')
     told, left = DecisionLoop(PlannerConfig()), DecisionLoop(PlannerConfig())
@@ -191,7 +191,7 @@ def test_the_scan_goes_into_the_memory_after_the_command_the_same_either_way():
         ctl.set_goal(np.asarray(world.goal, float), in_map=True)
     sim_cfg = SimConfig(sensor='ideal', range_noise=0.01, odom_distance_scale=1.02,
                         odom_yaw_scale=1.03)
-    with BurgerSim(world, sim_cfg) as sim:
+    with RobotSim(world, sim_cfg) as sim:
         start = sim.true_pose()
         for _ in range(30):
             odom, scan = sim.odometry()[0], sim.scan()
@@ -221,14 +221,14 @@ def _drive_between(world, sim_cfg, legs):
     the true distance to it then [m], collided)."""
     from subapf_planner.core.loop import DecisionLoop
     from subapf_planner.core.status import State
-    from subapf_planner.sim.simulator import BurgerSim
+    from subapf_planner.sim.simulator import RobotSim
     # the planner told the lidar it has (exact rays with 1 cm noise)
     ctl = DecisionLoop(PlannerConfig(scan_alignment=True, range_noise_floor=0.01,
                                      range_noise_fraction=0.0))
     goals = [np.asarray(world.goal, float), np.asarray(world.start[:2], float)] * legs
     misses, driven, corrected, odometry = [], 0.0, [], []
     ctl.set_goal(goals[0], in_map=True)
-    with BurgerSim(world, sim_cfg) as sim:
+    with RobotSim(world, sim_cfg) as sim:
         last = sim.true_pose()
         while sim.time < 300.0 * legs and not sim.collided and not ctl.state.gave_up:
             truth = sim.true_pose()

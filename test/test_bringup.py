@@ -45,7 +45,7 @@ def bad_params(tmp_path: Path, name: str, text: str) -> str:
 
 @pytest.mark.node
 @pytest.mark.parametrize('case', ['missing', 'a folder', 'not YAML', 'a bad value',
-                                  'the turtlebot4', 'the waffle_pi', 'another laser frame',
+                                  'a robot of your own', 'another laser frame',
                                   'ROS_DOMAIN_ID', 'plot folder'])
 def test_a_bad_argument_is_one_line_before_anything_starts(case, tmp_path, ros_env):
     world = str(WORLDS / 'fig6c_circle_in_front.yaml')
@@ -58,14 +58,14 @@ def test_a_bad_argument_is_one_line_before_anything_starts(case, tmp_path, ros_e
         'a bad value': (['--params', bad_params(
             tmp_path, 'value.yaml', 'subapf_planner:\n  ros__parameters:\n'
             '    max_linear_velocity: fast\n')], 'max_linear_velocity: expected a number'),
-        'the turtlebot4': (['--params', str(ROBOT_FILES / 'turtlebot4.yaml')],
-                           'is for the turtlebot4 (robot: turtlebot4), but the simulator '
-                           'can only be a TurtleBot3 burger'),
-        'the waffle_pi': (['--params', str(ROBOT_FILES / 'waffle_pi.yaml')],
-                          'but the simulator can only be a TurtleBot3 burger'),
+        'a robot of your own': (['--params', bad_params(
+            tmp_path, 'own.yaml', 'subapf_planner:\n  ros__parameters:\n    robot: other\n')],
+            'is for a robot of your own (robot: other), which the simulator cannot be; '
+            'give --robot'),
         'another laser frame': (['--params', bad_params(
             tmp_path, 'laser.yaml', 'subapf_planner:\n  ros__parameters:\n'
-            '    laser_frame: laser\n')], 'laser_frame is laser, but the simulator'),
+            '    laser_frame: laser\n')], 'laser_frame is laser, but the simulator (the '
+            'burger) sends its scans in base_scan'),
         'ROS_DOMAIN_ID': ([], "ROS_DOMAIN_ID='moon' is not a domain id"),
         'plot folder': (['--png', str(tmp_path / 'no' / 'run.png')], 'cannot write in'),
     }[case]
@@ -142,6 +142,42 @@ def test_the_run_is_in_the_users_domain(tmp_path, ros_env):
     assert f'domain {domain} (ROS_DOMAIN_ID)' in out.splitlines()[0], out
     assert heard['clock'] > 0 and heard['outcome'] == ['reached'], (heard, out)
     wait_for(lambda: not marked_processes(marker), 10.0, 'no process of the bringup left')
+
+
+@pytest.mark.core
+def test_the_robot_comes_from_the_option_else_the_params_file(tmp_path):
+    """--robot wins and brings its config/robots/ file after the params file; a params
+    file written for a robot is the planner's as it is, and that robot is simulated."""
+    from subapf_planner.tools.bringup import check_params
+    values, robot, files = check_params(str(PARAMS))
+    assert (robot, files) == ('burger', (str(PARAMS),))
+    values, robot, files = check_params(str(PARAMS), 'jackal')
+    assert robot == 'jackal' and files == (str(PARAMS), str(ROBOT_FILES / 'jackal.yaml'))
+    assert values['max_linear_velocity'] == 2.0 and values['laser_frame'] == 'front_laser'
+    values, robot, files = check_params(str(ROBOT_FILES / 'waffle_pi.yaml'))
+    assert robot == 'waffle_pi' and files == (str(ROBOT_FILES / 'waffle_pi.yaml'),)
+    own = bad_params(tmp_path, 'tb4.yaml', 'subapf_planner:\n  ros__parameters:\n'
+                     '    robot: turtlebot4\n    laser_frame: base_scan\n')
+    with pytest.raises(BringupError, match='laser_frame is base_scan, but the simulator '
+                       r'\(the turtlebot4\) sends its scans in rplidar_link'):
+        check_params(own)
+
+
+@pytest.mark.dds
+def test_the_jackal_closes_the_loop_over_dds(tmp_path, bringup_env):
+    """--robot jackal: the simulator is a Jackal (its rectangle, its 270 degree lidar on
+    front_laser at 50 Hz, base_link, Twist on cmd_vel) and the planner has its file (20 Hz,
+    2 m/s, the footprint): the goal 2 m ahead is reached in a few simulated seconds."""
+    world = tmp_path / 'short_hop.yaml'
+    world.write_text(SHORT.replace('goal: [1.0, 0.0]', 'goal: [2.0, 0.0]'))
+    r = bringup(bringup_env, '--world', str(world), '--robot', 'jackal', '--rate', '2',
+                '--png', str(tmp_path / 'run.png'), cwd=tmp_path, timeout=180)
+    assert r.returncode == 0, r.stdout + r.stderr
+    assert 'robot jackal' in r.stdout.splitlines()[0], r.stdout
+    done = [line for line in r.stdout.splitlines() if 'outcome reached' in line]
+    assert done, r.stdout
+    seconds = float(done[0].split('simulated time ')[1].split(' s')[0])
+    assert seconds < 8.0, done   # at 2 m/s, where the burger would take 10 s and more
 
 
 @pytest.mark.dds

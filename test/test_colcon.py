@@ -73,7 +73,7 @@ def test_colcon_build_installs_ros2_run_executables(tmp_path):
     assert {p.name for p in (share / 'launch').iterdir()} == {
         'planner.launch.py', 'sim.launch.py', 'nav2.launch.py'}
     assert {p.name for p in (share / 'config' / 'robots').iterdir()} == {
-        'burger.yaml', 'waffle_pi.yaml', 'turtlebot4.yaml'}
+        'burger.yaml', 'waffle_pi.yaml', 'turtlebot4.yaml', 'jackal.yaml'}
     # an installed executable runs (figures needs no ROS graph), from its entry point
     env['PYTHONPATH'] = os.pathsep.join(
         str(p) for p in prefix.glob('lib/python*/site-packages'))

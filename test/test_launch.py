@@ -128,5 +128,6 @@ def test_included_launch_arguments_are_declared_there():
     assert len(include) == 1
     given = keyword(include[0], 'launch_arguments').func.value   # {...}.items()
     assert {ast.literal_eval(k) for k in given.keys} <= planner_args
-    assert ast.literal_eval(given.values[[ast.literal_eval(k) for k in given.keys]
-                                         .index('robot')]) == 'burger'
+    robot = given.values[[ast.literal_eval(k) for k in given.keys].index('robot')]
+    assert ast.literal_eval(robot.args[0]) == 'robot'   # LaunchConfiguration('robot')
+    assert 'robot' in declared(sim)

@@ -11,7 +11,7 @@ from subapf_planner.core.config import PlannerConfig
 from subapf_planner.sim.episode import run_episode
 from subapf_planner.sim.faults import ScanFaults
 from subapf_planner.sim.metrics import min_clearance
-from subapf_planner.sim.simulator import BurgerSim, SimConfig
+from subapf_planner.sim.simulator import RobotSim, SimConfig
 from subapf_planner.sim.world import FOOTPRINT_RADIUS, WorldError, parse_world
 from subapf_planner.sim.worldgen import DYNAMIC_FAMILIES, START_MARGIN, generate_world
 from subapf_planner.tools.animation import animate_run
@@ -83,7 +83,7 @@ def test_interpolation_hold_loop_and_offset():
 def test_the_laser_sees_a_walker_where_its_path_puts_it():
     w = parse_world(doc({'circle': {'radius': 0.3}, 'path': [[0, 2.0, -3.0], [6, 2.0, 3.0]]},
                         goal=(0.0, 3.0)))
-    with BurgerSim(w, SimConfig(sensor='ideal')) as sim:
+    with RobotSim(w, SimConfig(sensor='ideal')) as sim:
         sim.step(3.0)   # the walker is at (2, 0), straight ahead of the laser
         scan = sim.scan()
     assert scan.ranges[0] == pytest.approx(2.0 - 0.3 + 0.032, abs=0.01)
@@ -98,7 +98,7 @@ def test_walker_into_a_standing_robot_is_a_collision_hit_while_stopped():
     (reached at once), the walker hits it; the collision says it stood still."""
     w = doc({'circle': {'radius': 0.3}, 'path': [[0, 2.0, 0.0], [4, -2.0, 0.0]]},
             goal=(0.05, 0.0), time_limit=10)
-    with BurgerSim(parse_world(w), SimConfig()) as sim:
+    with RobotSim(parse_world(w), SimConfig()) as sim:
         sim.set_command(0.0, 0.0)
         for _ in range(20):
             sim.step(0.2)
@@ -106,7 +106,7 @@ def test_walker_into_a_standing_robot_is_a_collision_hit_while_stopped():
     # a moving robot hit from behind is not "stopped"
     w2 = doc({'circle': {'radius': 0.3}, 'path': [[0, -1.5, 0.0], [3, 3.5, 0.0]]},
              goal=(6.0, 0.0))
-    with BurgerSim(parse_world(w2), SimConfig()) as sim:
+    with RobotSim(parse_world(w2), SimConfig()) as sim:
         for _ in range(20):
             sim.set_command(0.1, 0.0)
             sim.step(0.2)

@@ -374,15 +374,22 @@ def test_goal_unreachable_is_given_up_after_its_timeout_unless_a_way_opens():
 
 
 def test_tf_frames_follow_rep105():
+    from subapf_planner.core.robot import BURGER, JACKAL, TURTLEBOT4
     from subapf_planner.ros.conversions import transform_msg
-    from subapf_planner.ros.sim_node import BASE_LINK_HEIGHT, LASER_IN_BASE_LINK
+    from subapf_planner.ros.sim_node import static_links
     t = transform_msg('odom', 'base_footprint', (1.0, 2.0, 0.0), math.pi / 2, 3.5)
     assert (t.header.frame_id, t.child_frame_id) == ('odom', 'base_footprint')
     assert t.transform.rotation.z == pytest.approx(math.sqrt(0.5))
     assert t.header.stamp.sec == 3 and t.header.stamp.nanosec == 500_000_000
-    # base_scan 0.172 m above base_link, base_link 0.010 m above base_footprint
-    assert LASER_IN_BASE_LINK == pytest.approx((-0.032, 0.0, 0.172))
-    assert BASE_LINK_HEIGHT == 0.010
+    # the burger: base_scan 0.172 m above base_link, base_link 0.010 m above base_footprint
+    (p0, c0, up, yaw0), (p1, c1, laser, yaw1) = static_links(BURGER)
+    assert (p0, c0, up, yaw0) == ('base_footprint', 'base_link', (0.0, 0.0, 0.010), 0.0)
+    assert (p1, c1, yaw1) == ('base_link', 'base_scan', 0.0)
+    assert laser == pytest.approx((-0.032, 0.0, 0.172))
+    # base_link is the base frame of the TurtleBot 4 (its lidar turned a quarter) and Jackal
+    assert [(p, c) for p, c, _, _ in static_links(TURTLEBOT4)] == [('base_link', 'rplidar_link')]
+    assert static_links(TURTLEBOT4)[0][3] == pytest.approx(math.pi / 2)
+    assert static_links(JACKAL)[0][:2] == ('base_link', 'front_laser')
 
 
 def test_seed_command_sets_where_the_acceleration_limits_start():

@@ -24,8 +24,13 @@ def test_each_robot_file_configures_the_node(key):
     try:
         node = PlannerNode(context=context)
         cfg, options = node.ctl.cfg, node.options
-        assert cfg.robot_radius == cfg.inflation_radius == robot.radius
+        assert cfg.robot_radius == robot.radius
+        # a polygon: the field keeps its half-width from walls, the rest checks the polygon
+        half_width = max(abs(y) for _, y in robot.footprint) if robot.footprint else None
+        assert cfg.inflation_radius == (half_width or robot.radius)
+        assert (cfg.polygon is None) == (half_width is None)
         assert cfg.sample_clearance == pytest.approx(robot.radius + 0.03)
+        assert cfg.planning_frequency == robot.planning_frequency
         assert cfg.safety_distance > robot.radius
         assert cfg.laser_mount == pytest.approx(robot.laser.planar, abs=1e-6)
         assert cfg.max_linear_velocity == robot.max_linear_velocity
@@ -43,7 +48,7 @@ def test_each_robot_file_configures_the_node(key):
 def test_the_robots_differ_where_their_specifications_do():
     assert BURGER is ROBOTS['burger']
     radii = {k: r.radius for k, r in ROBOTS.items()}
-    assert radii['burger'] < radii['turtlebot4'] < radii['waffle_pi']
+    assert radii['burger'] < radii['turtlebot4'] < radii['waffle_pi'] < radii['jackal']
     # the TurtleBot 4's RPLIDAR is mounted turned a quarter turn, in its own frame
     tb4 = ROBOTS['turtlebot4']
     assert tb4.laser.yaw == pytest.approx(math.pi / 2) and tb4.laser_frame == 'rplidar_link'

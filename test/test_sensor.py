@@ -9,11 +9,11 @@ import math
 import numpy as np
 import pytest
 
-from subapf_planner.core.robot import compose, to_parent
+from subapf_planner.core.robot import BURGER, compose, to_parent
 from subapf_planner.core.scan import scan_to_points
 from subapf_planner.sim.faults import ScanDelivery, ScanFaults, delivery_faults
 from subapf_planner.sim.sensor import LIDARS, MIXED_EDGE, corrupt
-from subapf_planner.sim.simulator import ROBOT, BurgerSim, SimConfig
+from subapf_planner.sim.simulator import RobotSim, SimConfig
 from subapf_planner.sim.world import parse_world
 
 pytestmark = pytest.mark.sim
@@ -95,7 +95,7 @@ def test_a_turning_robots_sweep_is_bent_and_each_beams_own_pose_unbends_it(monke
     import subapf_planner.sim.simulator as simulator
     exact = dataclasses.replace(NOISE_ONLY, bands=((10.0, 0.0, 0.0),))
     monkeypatch.setattr(simulator, 'LIDARS', {**LIDARS, 'lds01': exact})   # timing alone
-    with BurgerSim(_room(), SimConfig(sensor='realistic', lidar='lds01')) as sim:
+    with RobotSim(_room(), SimConfig(sensor='realistic', lidar='lds01')) as sim:
         poses = {0.0: sim.true_pose()}
         for _ in range(100):   # 0.5 s: whole sweeps in the middle of the turn
             sim.set_command(0.0, 2.0)
@@ -105,7 +105,7 @@ def test_a_turning_robots_sweep_is_bent_and_each_beams_own_pose_unbends_it(monke
     sweep = next(s for s in sweeps if s.stamp > 0.1)   # (the first starts standing)
     assert sweep.time_increment == pytest.approx(0.2 / 360)
     assert sweep.scan_time == pytest.approx(0.2)
-    at_start = scan_to_points(sweep, poses[round(sweep.stamp, 6)], ROBOT.laser.planar)
+    at_start = scan_to_points(sweep, poses[round(sweep.stamp, 6)], BURGER.laser.planar)
     ok = np.isfinite(sweep.ranges)
     instants = [sweep.stamp + i * sweep.time_increment for i in range(360)]
     times = np.array(sorted(poses))
@@ -114,13 +114,13 @@ def test_a_turning_robots_sweep_is_bent_and_each_beams_own_pose_unbends_it(monke
 
     def at(t):   # the true pose at instant t, between the recorded steps
         return [np.interp(t, times, track[:, k]) for k in range(3)]
-    own = np.array([to_parent(compose(at(ti), ROBOT.laser.planar),
+    own = np.array([to_parent(compose(at(ti), BURGER.laser.planar),
                               [[r * math.cos(a), r * math.sin(a)]])[0]
                     for ti, r, a in zip(instants, sweep.ranges, sweep.angles, strict=True)])
     late = np.arange(360)[ok] > 300
     assert np.max(_off_walls(own[ok])) < 0.005   # each beam at its own instant
     assert np.median(_off_walls(at_start[late])) > 0.1
-    with BurgerSim(_room(), SimConfig(sensor='ideal')) as sim:
+    with RobotSim(_room(), SimConfig(sensor='ideal')) as sim:
         sim.set_command(0.0, 2.0)
         sim.step(0.4)
         ideal = sim.sweeps()

@@ -5,7 +5,8 @@ import math
 import numpy as np
 import pytest
 
-from subapf_planner.sim.simulator import ROBOT, BurgerSim, SimConfig
+from subapf_planner.core.robot import BURGER
+from subapf_planner.sim.simulator import RobotSim, SimConfig
 from subapf_planner.sim.world import parse_world
 
 pytestmark = pytest.mark.sim
@@ -17,7 +18,7 @@ def world(obstacles=(), start=(0.0, 0.0, 0.0)):
 
 
 def test_straight_drive_covers_v_times_t():
-    with BurgerSim(world()) as sim:
+    with RobotSim(world()) as sim:
         for _ in range(25):
             sim.set_command(0.2, 0.0)
             sim.step(0.2)
@@ -27,7 +28,7 @@ def test_straight_drive_covers_v_times_t():
 
 
 def test_rotation_covers_w_times_t():
-    with BurgerSim(world()) as sim:
+    with RobotSim(world()) as sim:
         for _ in range(5):
             sim.set_command(0.0, 1.0)
             sim.step(0.2)
@@ -38,9 +39,9 @@ def test_rotation_covers_w_times_t():
 
 def test_lidar_range_to_known_box():
     box = {'box': {'center': [2.0, 0.0], 'size': [0.2, 2.0]}}
-    with BurgerSim(world([box]), SimConfig(sensor='ideal')) as sim:
+    with RobotSim(world([box]), SimConfig(sensor='ideal')) as sim:
         scan = sim.scan()
-    face = 2.0 - 0.1 - ROBOT.laser.x
+    face = 2.0 - 0.1 - BURGER.laser.x
     assert scan.ranges[0] == pytest.approx(face, abs=1e-3)
     # beam 10 deg off axis hits the same plane at face / cos(10 deg)
     assert scan.ranges[10] == pytest.approx(face / math.cos(math.radians(10)), abs=2e-3)
@@ -50,7 +51,7 @@ def test_lidar_range_to_known_box():
 
 def test_driving_into_a_wall_reports_collision():
     box = {'box': {'center': [1.0, 0.0], 'size': [0.2, 2.0]}}
-    with BurgerSim(world([box])) as sim:
+    with RobotSim(world([box])) as sim:
         for _ in range(40):
             sim.set_command(0.2, 0.0)
             sim.step(0.2)
@@ -61,7 +62,7 @@ def test_driving_into_a_wall_reports_collision():
 
 
 def test_command_watchdog_stops_the_robot():
-    with BurgerSim(world(), SimConfig(cmd_timeout=0.5)) as sim:
+    with RobotSim(world(), SimConfig(cmd_timeout=0.5)) as sim:
         sim.set_command(0.2, 0.0)
         sim.step(2.0)
         x_after = sim.true_pose()[0]
@@ -73,14 +74,14 @@ def test_command_watchdog_stops_the_robot():
 def test_same_seed_same_noise():
     cfg = SimConfig(range_noise=0.01, beam_dropout=0.1, seed=7)
     box = {'circle': {'center': [1.5, 0.0], 'radius': 0.3}}
-    with BurgerSim(world([box]), cfg) as a, BurgerSim(world([box]), cfg) as b:
+    with RobotSim(world([box]), cfg) as a, RobotSim(world([box]), cfg) as b:
         np.testing.assert_array_equal(a.scan().ranges, b.scan().ranges)
-    with BurgerSim(world([box]), SimConfig(range_noise=0.01, seed=8)) as c:
+    with RobotSim(world([box]), SimConfig(range_noise=0.01, seed=8)) as c:
         assert not np.array_equal(c.scan().ranges, a_ranges(cfg, box))
 
 
 def a_ranges(cfg, box):
-    with BurgerSim(world([box]), cfg) as s:
+    with RobotSim(world([box]), cfg) as s:
         return s.scan().ranges
 
 
@@ -92,7 +93,7 @@ def test_bad_sim_config():
 def _drive(cfg, commands):
     """Run (v, w, seconds) commands; returns (true, odometry) poses after each 0.2 s."""
     true, odom = [], []
-    with BurgerSim(world(), cfg) as sim:
+    with RobotSim(world(), cfg) as sim:
         for v, w, seconds in commands:
             for _ in range(int(round(seconds / 0.2))):
                 sim.set_command(v, w)
@@ -124,7 +125,7 @@ def test_odometry_drift_grows_as_configured():
 def test_solver_iterations_reach_the_physics_engine():
     import pybullet
     for n in (50, 10):
-        with BurgerSim(world(), SimConfig(solver_iterations=n)) as sim:
+        with RobotSim(world(), SimConfig(solver_iterations=n)) as sim:
             got = pybullet.getPhysicsEngineParameters(physicsClientId=sim._cid)
             assert got['numSolverIterations'] == n
     with pytest.raises(ValueError, match='solver_iterations'):
@@ -132,7 +133,7 @@ def test_solver_iterations_reach_the_physics_engine():
 
 
 def test_perfect_odometry_starts_at_the_start_and_then_is_the_true_pose():
-    with BurgerSim(world(start=(1.0, -2.0, 0.3)), SimConfig()) as sim:
+    with RobotSim(world(start=(1.0, -2.0, 0.3)), SimConfig()) as sim:
         np.testing.assert_array_equal(sim.odometry()[0], [1.0, -2.0, 0.3])
         sim.set_command(0.2, 0.5)
         sim.step(0.4)
@@ -148,7 +149,7 @@ def test_scan_threads_change_the_speed_not_the_ranges():
     obstacles = [{'circle': {'center': [float(x), float(y)], 'radius': 0.2}}
                  for x, y in rng.uniform(-3.0, 3.0, (25, 2)) if math.hypot(x, y) > 0.6]
     obstacles += [{'box': {'center': [0.0, 3.2], 'size': [6.0, 0.2], 'yaw': 0.3}}]
-    sims = [BurgerSim(world(obstacles), SimConfig(scan_threads=n, sensor='ideal'))
+    sims = [RobotSim(world(obstacles), SimConfig(scan_threads=n, sensor='ideal'))
             for n in (1, 0)]
     try:
         for _ in range(12):

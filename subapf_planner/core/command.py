@@ -8,7 +8,10 @@ that covers the step in one planning period, scaled by cos(heading error) and
 slowed inside ``slowdown_distance`` of the goal; then acceleration limits;
 last, the safety corridor zeroes forward speed while an obstacle point lies
 ahead, within ``robot_radius`` of the heading line and closer than
-``safety_distance`` to the centre. Stops are immediate (not rate limited).
+``safety_distance`` to the centre (with a footprint polygon: within its half-width;
+and where turning on the spot would sweep a corner into something it backs straight
+up, ``backing_up``, while the way behind is clear, else stops). Stops are immediate
+(not rate limited).
 """
 
 from __future__ import annotations
@@ -20,7 +23,13 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from .config import PlannerConfig
+from .footprint import TURN_MARGIN
 from .status import Status
+
+#: Backing up to make room for a turn: at this fraction of the top speed (at most
+#: reverse_speed), while nothing lies within BACKING_REACH [m] behind the footprint.
+BACKING_SPEED = 0.25
+BACKING_REACH = 0.15
 
 
 @dataclass(frozen=True)
@@ -39,7 +48,9 @@ def wrap_angle(a: float) -> float:
 
 def forward_blocked(pose: ArrayLike, obstacles: ArrayLike, cfg: PlannerConfig) -> bool:
     """True when an obstacle point lies ahead (x > 0 in the robot frame), within the
-    corridor |y| <= robot_radius and closer than safety_distance to the centre."""
+    corridor |y| <= robot_radius and closer than safety_distance to the centre; with a
+    footprint polygon, within its half-width and closer than safety_distance -
+    robot_radius to its front."""
     obs = np.asarray(obstacles, float).reshape(-1, 2)
     if obs.shape[0] == 0:
         return False
@@ -48,9 +59,41 @@ def forward_blocked(pose: ArrayLike, obstacles: ArrayLike, cfg: PlannerConfig) -
     c, s = math.cos(yaw), math.sin(yaw)
     fx = c * dx + s * dy
     fy = -s * dx + c * dy
+    shape = cfg.polygon
+    if shape is not None:
+        reach = shape.front + cfg.safety_distance - cfg.robot_radius
+        hit = (fx > 0.0) & (np.abs(fy) <= shape.half_width) & (fx < reach)
+        return bool(np.any(hit))
     hit = (fx > 0.0) & (np.abs(fy) <= cfg.robot_radius) & (np.hypot(fx, fy)
                                                              < cfg.safety_distance)
     return bool(np.any(hit))
+
+
+def backward_blocked(pose: ArrayLike, obstacles: ArrayLike, cfg: PlannerConfig) -> bool:
+    """With a footprint polygon, whether an obstacle point lies behind it within its
+    half-width and BACKING_REACH of its rear (True for a disc: it never backs up here)."""
+    shape = cfg.polygon
+    if shape is None:
+        return True
+    x, y, yaw = (float(v) for v in pose)
+    obs = np.asarray(obstacles, float).reshape(-1, 2)
+    c, s = math.cos(yaw), math.sin(yaw)
+    fx = c * (obs[:, 0] - x) + s * (obs[:, 1] - y)
+    fy = -s * (obs[:, 0] - x) + c * (obs[:, 1] - y)
+    rear = float(shape.vertices[:, 0].min())
+    hit = (fx < 0.0) & (np.abs(fy) <= shape.half_width + TURN_MARGIN) \
+        & (fx > rear - BACKING_REACH)
+    return bool(np.any(hit))
+
+
+def turn_blocked(pose: ArrayLike, turn: float, obstacles: ArrayLike,
+                 cfg: PlannerConfig) -> bool:
+    """With a footprint polygon, whether turning on the spot by ``turn`` [rad] brings a
+    corner within TURN_MARGIN of an obstacle point (a disc turns freely)."""
+    shape = cfg.polygon
+    if shape is None:
+        return False
+    return shape.turn_contact(pose, turn, obstacles, TURN_MARGIN)
 
 
 def _clamp(value: float, limit: float) -> float:
@@ -79,10 +122,18 @@ def shape_command(pose: ArrayLike, target: ArrayLike | None, goal: ArrayLike,
     w = _clamp(cfg.heading_gain * alpha, cfg.max_angular_velocity)
     if abs(alpha) > cfg.rotate_in_place_angle:
         v, status = 0.0, Status.TURNING
+        if turn_blocked(pose, alpha, obstacles, cfg):
+            # a polygon's corner would sweep into something: back up to make room, or stop
+            if cfg.reverse_speed <= 0.0 or backward_blocked(pose, obstacles, cfg):
+                return Command(0.0, 0.0, Status.NO_SAFE_MOVE)
+            return Command(-min(cfg.reverse_speed, BACKING_SPEED * cfg.max_linear_velocity),
+                           0.0, Status.BACKING_UP)
     else:
         slow = 1.0
         if cfg.slowdown_distance > 0.0:
-            slow = min(1.0, max(0.25, dist_goal / cfg.slowdown_distance))
+            floor = min(1.0, cfg.approach_speed / cfg.max_linear_velocity) \
+                if cfg.max_linear_velocity > 0.0 else 1.0
+            slow = min(1.0, max(floor, dist_goal / cfg.slowdown_distance))
         v = min(cfg.max_linear_velocity * slow, dist / cfg.period) * math.cos(alpha)
         v, status = max(v, 0.0), Status.DRIVING
     v_prev, w_prev = previous

@@ -10,13 +10,16 @@ from __future__ import annotations
 
 import dataclasses
 from dataclasses import dataclass
+import functools
 import math
 from pathlib import Path
 from typing import Any, Mapping
 
+import numpy as np
 import yaml
 
 from .critics import critic_class
+from .footprint import Footprint, format_footprint, parse_footprint
 from .params import ConfigError, build, check_fields, param
 from .robot import BURGER, RobotDescription
 
@@ -101,8 +104,17 @@ class PlannerConfig:
                                     'stop on entering it', 'm', 0.0, 5.0)
     slowdown_distance: float = param(0.4, 'Speed scales down linearly inside this distance '
                                       'of the goal', 'm', 0.0, 10.0)
+    approach_speed: float = param(0.055, 'Least speed the slow-down near the goal comes to '
+                                  "(a quarter of the burger's top speed: a fast robot's "
+                                  'quarter would pass the goal tolerance in a period)',
+                                  'm/s', 0.0, 5.0)
     robot_radius: float = param(BURGER.radius, 'Robot radius: half-width of the forward safety '
-                                 'corridor; the field inflates obstacles by it', 'm', 0.0, 2.0)
+                                 'corridor; the field inflates obstacles by it (with a '
+                                 'footprint: the circle that holds it)', 'm', 0.0, 2.0)
+    footprint: str = param('', "The robot's footprint as a convex polygon in base_footprint, "
+                           "Nav2's format '[[x, y], ...]' (clockwise is reversed): samples, "
+                           'the corridor ahead and turns on the spot are checked against it '
+                           "(core/footprint.py); '': a disc of robot_radius")
     safety_distance: float = param(BURGER.safety_distance, 'Forward speed is zeroed while an '
                                     'obstacle point lies in the corridor ahead closer than this '
                                     'to the centre '
@@ -245,9 +257,19 @@ class PlannerConfig:
         check_fields(self)
         for name in self.critics:
             critic_class(name)   # ConfigError for a name that is no critic
+        shape = self.polygon   # ConfigError for a footprint that is no convex polygon
+        if shape is not None and shape.circumscribed > self.robot_radius + 1e-6:
+            raise ConfigError(f'robot_radius: {self.robot_radius} m does not hold the '
+                              f'footprint (its farthest vertex is {shape.circumscribed:.3f} m '
+                              'out)')
         if self.sample_radius >= self.danger_distance * 4:
             raise ConfigError('sample_radius: must be below 4 * danger_distance '
                               f'({self.sample_radius} >= {4 * self.danger_distance})')
+
+    @functools.cached_property
+    def polygon(self) -> Footprint | None:
+        """The footprint's polygon; None: a disc of robot_radius."""
+        return parse_footprint(self.footprint)
 
     @property
     def k(self) -> float:
@@ -296,17 +318,36 @@ def robot_fields(robot: RobotDescription) -> dict[str, float]:
     """The PlannerConfig fields that come from ``robot``: its footprint and the clearances
     derived from it (inflation, samples, DWA, the safety corridor), its laser's mounting
     and range (at most half the default occupancy window: a return beyond it has no
-    cell), its limits."""
+    cell), its limits and planning rate, and the lengths the planner steps by, scaled by
+    how far the robot goes in one period (RobotDescription.pace: the sampling circle,
+    the longest raw step, the slow-down before the goal; 1 for the burger, whose
+    figures they are), and its acceleration limits where the robot states them; a robot
+    whose laser does not see behind it never reverses (reverse_speed 0)."""
     mount = robot.laser
+    pace = robot.pace
+    # a polygon: the field keeps the half-width from walls (a gap the robot drives
+    # straight through), the sampling and the command check the polygon itself
+    inflation = Footprint(np.asarray(robot.footprint, float)).half_width \
+        if robot.footprint else robot.radius
+    accelerations = {
+        name: value for name, value in (
+            ('max_linear_acceleration', robot.max_linear_acceleration),
+            ('max_angular_acceleration', robot.max_angular_acceleration)) if value is not None}
     return {
-        'robot_radius': robot.radius, 'inflation_radius': robot.radius,
+        'robot_radius': robot.radius, 'inflation_radius': inflation,
+        'footprint': format_footprint(robot.footprint) if robot.footprint else '',
         'sample_clearance': robot.clearance, 'dwa_clearance': robot.clearance,
         'safety_distance': robot.safety_distance,
         'laser_x': mount.x, 'laser_y': mount.y, 'laser_yaw': round(mount.yaw, 6),
         'obstacle_range': min(robot.laser_range, PlannerConfig.map_size / 2),
         'max_linear_velocity': robot.max_linear_velocity,
-        'reverse_speed': robot.max_linear_velocity,
-        'max_angular_velocity': robot.max_angular_velocity}
+        'reverse_speed': robot.max_linear_velocity if robot.sees_all_round else 0.0,
+        'max_angular_velocity': robot.max_angular_velocity,
+        'planning_frequency': robot.planning_frequency,
+        'sample_radius': round(PlannerConfig.sample_radius * pace, 4),
+        'max_step': round(PlannerConfig.max_step * pace, 4),
+        'slowdown_distance': round(PlannerConfig.slowdown_distance * pace, 4),
+        **accelerations}
 
 
 #: The PlannerConfig limits bounded by what the robot can do: field -> the

@@ -29,9 +29,11 @@ from .status import Status
 #: most (a scan repeated with the same stamp is not taken twice).
 FIRST_SCANS = 3
 #: Inside goal_tolerance, a cycle that brings the robot less than this closer to the goal
-#: ends the approach (it cannot get closer: arrival_distance) [m]; a tenth of the
-#: distance the burger drives in one 0.2 s period at its slowest approach speed.
+#: ends the approach (it cannot get closer: arrival_distance) [m] for a 0.2 s period, in
+#: proportion for another; a tenth of the distance the burger drives in one 0.2 s period
+#: at its slowest approach speed.
 ARRIVAL_PROGRESS = 0.002
+ARRIVAL_PERIOD = 0.2
 
 
 def input_status(pose: ArrayLike, goal: ArrayLike) -> Status | None:
@@ -61,7 +63,8 @@ def goal_status(cfg: PlannerConfig, goal_distance: float, goal: NDArray[np.float
 class Goal(Stage):
     """``reached`` or ``goal_in_obstacle`` (:func:`goal_status`). With the memory, the
     approach goes on inside goal_tolerance while the robot is farther than
-    ``arrival_distance`` and each cycle brings it at least ARRIVAL_PROGRESS closer (a
+    ``arrival_distance`` and each cycle brings it at least ARRIVAL_PROGRESS closer (per
+ARRIVAL_PERIOD of planning period; a
     pose error of a few centimetres still leaves it inside the tolerance)."""
 
     name = 'goal'
@@ -87,7 +90,8 @@ class Goal(Stage):
         if self._approach is None or not np.array_equal(self._approach[0], cycle.goal):
             return True
         before = self._approach[1]
-        return before > cfg.goal_tolerance or before - distance >= ARRIVAL_PROGRESS
+        return before > cfg.goal_tolerance \
+            or before - distance >= ARRIVAL_PROGRESS * (cfg.period / ARRIVAL_PERIOD)
 
 
 class Mapping(Stage):

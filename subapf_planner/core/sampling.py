@@ -10,6 +10,9 @@ the distance to the goal of the APF step taken from it (the "next next move
 point"), and ``priority``, the Fig. 5 priority sample's bonus
 (core/critics/priority.py says how this package reads Fig. 5).
 
+A robot with a footprint polygon (``footprint``) is placed on each sample, facing the
+way it drives there, instead (safe_samples).
+
 The lowest score wins; ties go to the lowest index (the one closest to the goal
 bearing, then clockwise). If every sample is discarded there is no safe move
 and ``chosen`` is None: the caller stops the robot.
@@ -85,6 +88,22 @@ def heading_target(point: ArrayLike, goal: ArrayLike,
     return np.asarray(goal, float)
 
 
+def safe_samples(samples: NDArray[np.float64], clear: NDArray[np.float64],
+                 position: ArrayLike, obstacles: ArrayLike,
+                 cfg: PlannerConfig) -> NDArray[np.bool_]:
+    """Algorithm 1's test: the samples farther than the discard distance from every
+    obstacle point; with a footprint polygon and the memory's field, instead those where
+    the polygon, placed on the sample facing the way the robot drives there from
+    ``position``, keeps sample_clearance - robot_radius from every point
+    (core/footprint.py)."""
+    shape = cfg.polygon
+    if shape is None or not cfg.geodesic:
+        return clear > cfg.discard_distance
+    way = samples - np.asarray(position, float)
+    poses = np.column_stack((samples, np.arctan2(way[:, 1], way[:, 0])))
+    return ~shape.contact(poses, obstacles, cfg.sample_clearance - cfg.robot_radius)
+
+
 def sample_and_choose(raw_point: ArrayLike, position: ArrayLike, goal: ArrayLike,
                       obstacles: ArrayLike, repulsion_obstacles: ArrayLike,
                       cfg: PlannerConfig, field: NavigationField | None = None,
@@ -99,7 +118,7 @@ def sample_and_choose(raw_point: ArrayLike, position: ArrayLike, goal: ArrayLike
     samples = circle_samples(raw_point, heading_target(raw_point, goal, field),
                              cfg.num_samples, cfg.sample_radius)
     clear = clearance(samples, obstacles)
-    ctx = Samples(samples, clear, clear > cfg.discard_distance,
+    ctx = Samples(samples, clear, safe_samples(samples, clear, position, obstacles, cfg),
                   np.asarray(raw_point, float), np.asarray(position, float),
                   np.asarray(goal, float), np.asarray(obstacles, float).reshape(-1, 2),
                   np.asarray(repulsion_obstacles, float).reshape(-1, 2), field)

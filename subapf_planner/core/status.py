@@ -16,6 +16,9 @@ class Status(StrEnum):
     DRIVING = 'driving'
     TURNING = 'turning'
     BLOCKED_AHEAD = 'blocked_ahead'
+    #: A footprint polygon's corner would sweep into something if it turned on the spot:
+    #: it backs straight up to make room (core/command.py).
+    BACKING_UP = 'backing_up'
     #: The planned command would meet a moving obstacle: replaced (core/evasion.py).
     EVADING = 'evading'
     REACHED = 'reached'

@@ -43,6 +43,11 @@ def default_params_file() -> Path:
     return _find('config/planner.yaml')
 
 
+def robot_params_file(robot: str) -> Path:
+    """The planner parameters of a shipped robot: config/robots/<robot>.yaml."""
+    return _find(f'config/robots/{robot}.yaml')
+
+
 def fastdds_profile_file() -> Path:
     """The package's Fast DDS profile, config/fastdds.xml (see ros/processes.py)."""
     return _find('config/fastdds.xml')

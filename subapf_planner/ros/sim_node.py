@@ -1,8 +1,10 @@
-"""``sim_node`` (``subapf-sim``): the PyBullet burger stand-in as a ROS 2 node.
+"""``sim_node`` (``subapf-sim``): the PyBullet simulator of one robot as a ROS 2 node.
 
+The robot is ``robot`` (core/robot.py: the burger by default), in its own frames.
 Publishes ``/clock`` (rosgraph_msgs/Clock) and stamps everything with
-simulated time, ``scan`` (frame base_scan, sensor-data QoS, 5 Hz), ``odom``
-(odom -> base_footprint, 20 Hz), ``ground_truth`` (nav_msgs/Odometry in the
+simulated time, ``scan`` (the robot's laser frame, base_scan for a TurtleBot3,
+sensor-data QoS, at its lidar's rate: 5 Hz for the LDS-01), ``odom``
+(odom -> the robot's base frame, 20 Hz), ``ground_truth`` (nav_msgs/Odometry in the
 world frame) and each attempt's outcome on ``sim_outcome`` (std_msgs/String:
 reached, collision or timeout; transient-local, once per attempt). Subscribes
 ``cmd_vel`` (TwistStamped, or Twist with enable_stamped_cmd_vel:=false) and
@@ -37,10 +39,10 @@ from std_msgs.msg import String
 from visualization_msgs.msg import MarkerArray
 
 from ..core.params import ConfigError, check_fields, param
-from ..core.robot import compose, invert
+from ..core.robot import RobotDescription, compose, invert
 from ..sim.attempt import Attempts
 from ..sim.faults import FAULT_SEED_OFFSET, ScanDelivery, ScanFaults, delivery_faults
-from ..sim.simulator import ROBOT, BurgerSim, SimConfig
+from ..sim.simulator import RobotSim, SimConfig
 from ..sim.solvability import world_map
 from ..sim.world import WorldError, load_world
 from .conversions import (
@@ -59,15 +61,25 @@ from .usage import node_usage
 
 #: Simulated time per timer tick [s]; odometry and /clock go out every tick.
 TICK = 0.05
+#: How often map -> odom and the moving obstacles' markers go out [s].
 SCAN_PERIOD = 0.2
 #: Frames a goal on goal_pose may be given in: the simulator's odom frame, and map (the
 #: planner's memory frame: odom as it was at the start); both are the world frame.
 GOAL_FRAMES = ('', 'odom', 'map')
-#: REP-105 frames of the burger: base_link above base_footprint, base_scan in base_link.
-BASE_LINK_HEIGHT = ROBOT.base_link_height
-LASER_IN_BASE_LINK = (ROBOT.laser.x, ROBOT.laser.y, ROBOT.laser.z - BASE_LINK_HEIGHT)
 #: Shortest wall-clock period of the stepping timer [s].
 MIN_TIMER_PERIOD = 0.005
+
+
+def static_links(robot: RobotDescription
+                 ) -> list[tuple[str, str, tuple[float, float, float], float]]:
+    """The robot's fixed frames as /tf_static has them (REP-105): (parent, child, xyz
+    [m], yaw [rad]): base_footprint -> base_link -> the laser, or base_link -> the laser
+    for a robot whose base frame is base_link."""
+    laser, height = robot.laser, robot.base_link_height
+    links = [('base_link', robot.laser_frame, (laser.x, laser.y, laser.z - height), laser.yaw)]
+    if robot.base_frame != 'base_link':
+        links.insert(0, (robot.base_frame, 'base_link', (0.0, 0.0, height), 0.0))
+    return links
 
 
 @dataclass(frozen=True)
@@ -114,7 +126,8 @@ class SimNode(Node):
                              'world:=FILE (see --help)')
         self.world = load_world(options.world)
         sim_cfg = read(self, SimConfig)
-        self.sim = BurgerSim(self.world, sim_cfg)
+        self.sim = RobotSim(self.world, sim_cfg)
+        self.robot = self.sim.robot
         self._scans: ScanDelivery[LaserScan] = ScanDelivery(
             delivery_faults(sim_cfg, read(self, ScanFaults)), sim_cfg.seed + FAULT_SEED_OFFSET)
         self.clock_pub = self.create_publisher(Clock, '/clock', 10)
@@ -141,12 +154,13 @@ class SimNode(Node):
         self.timer = self.create_timer(self.ticks_per_call * TICK / options.rate,
                                        self._on_timer)
         self.get_logger().info(f'world {self.world.name} from {options.world}, '
-                               f'rate {options.rate}x')
+                               f'rate {options.rate}x, robot {sim_cfg.robot}')
 
     def _setup_tf(self) -> None:
-        """/tf (odom -> base_footprint) and /tf_static (base_footprint -> base_link ->
-        base_scan) when tf2_msgs is installed (a Jazzy install has it; the PyPI wheels
-        this project tests with do not, and then odom alone carries the pose)."""
+        """/tf (odom -> the base frame) and /tf_static (base_footprint -> base_link ->
+        the laser, or base_link -> the laser for a robot whose base frame is base_link)
+        when tf2_msgs is installed (a Jazzy install has it; the PyPI wheels this project
+        tests with do not, and then odom alone carries the pose)."""
         try:
             from tf2_msgs.msg import TFMessage
         except ImportError:
@@ -157,8 +171,8 @@ class SimNode(Node):
         self.tf_pub = self.create_publisher(TFMessage, '/tf', 10)
         static = self.create_publisher(TFMessage, '/tf_static', LATCHED)
         static.publish(TFMessage(transforms=[
-            transform_msg('base_footprint', 'base_link', (0.0, 0.0, BASE_LINK_HEIGHT), 0.0, 0.0),
-            transform_msg('base_link', 'base_scan', LASER_IN_BASE_LINK, 0.0, 0.0)]))
+            transform_msg(parent, child, xyz, yaw, 0.0)
+            for parent, child, xyz, yaw in static_links(self.robot)]))
 
     def _on_cmd(self, msg: Twist | TwistStamped) -> None:
         self.sim.set_command(*cmd_from_msg(msg))
@@ -186,14 +200,16 @@ class SimNode(Node):
         sim.step(TICK)
         t = sim.time
         pose, twist = sim.odometry()
-        self.odom_pub.publish(odom_to_msg(pose, twist, t))
+        base = self.robot.base_frame
+        self.odom_pub.publish(odom_to_msg(pose, twist, t, child_frame_id=base))
         if self.tf_pub is not None and listened(self.tf_pub):
             self.tf_pub.publish(self._tf_message(transforms=[transform_msg(
-                'odom', 'base_footprint', (pose[0], pose[1], 0.0), pose[2], t)]))
+                'odom', base, (pose[0], pose[1], 0.0), pose[2], t)]))
         if listened(self.truth_pub):
             self.truth_pub.publish(odom_to_msg(sim.true_pose(), twist, t, 'world'))
         for sweep in sim.sweeps():   # as the lidar's driver publishes them
-            self._scans.capture(scan_to_msg(sweep, 'base_scan'), sim.sweep_end(sweep))
+            self._scans.capture(scan_to_msg(sweep, self.robot.laser_frame),
+                                sim.sweep_end(sweep))
         if t + 1e-9 >= self._next_scan:
             self._next_scan += SCAN_PERIOD
             if self._map_error is not None and self.tf_pub is not None:
@@ -236,11 +252,13 @@ def usage() -> str:
     """``subapf-sim --help``."""
     return node_usage(
         'subapf-sim', 'sim_node', 'subapf_sim', """
-        The PyBullet TurtleBot3 burger stand-in: loads the world file (parameter world,
-        required; format v1, docs/worlds.md), subscribes cmd_vel and goal_pose, publishes
-        /clock, scan (base_scan, 5 Hz), odom (20 Hz), ground_truth, moving_obstacles, /tf
-        and /tf_static (with tf2_msgs), and on sim_outcome (std_msgs/String, transient
-        local) the outcome of each attempt: reached, collision or timeout.
+        The PyBullet simulator of a robot of core/robot.py (parameter robot: burger,
+        waffle_pi, turtlebot4, jackal): loads the world file (parameter world, required;
+        format v1, docs/worlds.md), subscribes cmd_vel and goal_pose, publishes /clock,
+        scan (the robot's laser frame, at its lidar's rate), odom (20 Hz), ground_truth,
+        moving_obstacles, /tf and /tf_static (with tf2_msgs), and on sim_outcome
+        (std_msgs/String, transient local) the outcome of each attempt: reached,
+        collision or timeout.
 
         The first attempt is at the world's goal from the start; each goal sent on
         goal_pose (frame odom or map: the world frame) starts another, with the world's

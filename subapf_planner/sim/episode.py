@@ -20,12 +20,13 @@ import numpy as np
 from ..core.config import PlannerConfig
 from ..core.known_map import KnownMap
 from ..core.loop import DecisionLoop, Supervision
+from ..core.robot import ROBOTS
 from ..core.scan import Scan
 from ..core.status import Outcome, State
 from .faults import FAULT_SEED_OFFSET, ScanDelivery, ScanFaults, delivery_faults
 from .metrics import mean_abs_curvature, min_clearance, path_length
 from .outcome import outcome_of
-from .simulator import BurgerSim, SimConfig
+from .simulator import RobotSim, SimConfig
 from .world import World
 
 #: How a run ends when the planner gives the goal up.
@@ -68,6 +69,8 @@ class EpisodeResult:
     #: The decision loop's state and reason at the end ('unreachable: no way to the goal
     #: for 30 s (why), goal abandoned').
     final_state: str = ''
+    #: The robot simulated (core/robot.py ROBOTS).
+    robot: str = 'burger'
 
     @property
     def cycles(self) -> int:
@@ -81,7 +84,8 @@ class EpisodeResult:
             'outcome': str(self.outcome),
             'time_s': round(self.time_s, 3),
             'path_length': round(path_length(self.path), 4),
-            'min_clearance': round(min_clearance(world, self.path, self.times), 4),
+            'min_clearance': round(min_clearance(world, self.path, self.times,
+                                                 ROBOTS[self.robot]), 4),
             'mean_abs_curvature': round(mean_abs_curvature(self.path), 4),
             'plan_ms_median': round(float(np.median(self.plan_ms)), 4) if self.cycles else 0.0,
             'plan_ms_p99': round(float(np.percentile(self.plan_ms, 99)), 4)
@@ -100,6 +104,7 @@ class EpisodeResult:
             'evading_cycles': int(self.statuses.get('evading', 0)),
             'moving_world': self.moving_world,
             'final_state': self.final_state,
+            'robot': self.robot,
         }
 
 
@@ -125,7 +130,7 @@ def run_episode(world: World, cfg: PlannerConfig, sim_cfg: SimConfig | None = No
     path, times, plan_ms, recomputed, statuses, field_ms, after_ms = [], [], [], [], {}, [], []
     pose_error = []   # per planning cycle: the planned-from pose's distance to the truth
     odom_error = []   # ... and odometry's own
-    with BurgerSim(world, sim_cfg) as sim:
+    with RobotSim(world, sim_cfg) as sim:
         while True:
             truth = sim.true_pose()
             path.append(truth)
@@ -171,4 +176,4 @@ def run_episode(world: World, cfg: PlannerConfig, sim_cfg: SimConfig | None = No
                          np.asarray(plan_ms), final, statuses, np.asarray(recomputed, bool),
                          np.asarray(times), hit_while_stopped, np.asarray(field_ms),
                          np.asarray(after_ms), np.asarray(pose_error), bool(world.moving),
-                         np.asarray(odom_error), ctl.text)
+                         np.asarray(odom_error), ctl.text, sim_cfg.robot)

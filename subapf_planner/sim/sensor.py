@@ -65,6 +65,26 @@ class Lidar:
     #: surface): the LDS-01's driver 0.0, the RPLIDAR's +inf. A 0.0 clears no cell of
     #: the memory; an open beam (+inf) clears its whole length.
     no_return: float = 0.0
+    #: The field of view [rad] (a whole turn: beams 2 pi / beams apart; less: its first
+    #: and last beam at its edges) and its first beam's angle in the laser's frame [rad].
+    fov: float = 2.0 * math.pi
+    angle_min: float = 0.0
+
+    @property
+    def angle_increment(self) -> float:
+        """The angle between two beams [rad]."""
+        if self.fov >= 2.0 * math.pi - 1e-9:
+            return 2.0 * math.pi / self.beams
+        return self.fov / max(self.beams - 1, 1)
+
+    def angles(self, beams: int | None = None) -> NDArray[np.float64]:
+        """Each beam's angle in the laser's frame [rad] (``beams`` over the same field of
+        view: default the lidar's own)."""
+        n = self.beams if beams is None else beams
+        k = np.arange(n)
+        if self.fov >= 2.0 * math.pi - 1e-9:
+            return self.angle_min + 2.0 * math.pi * k / n
+        return self.angle_min + self.fov * k / max(n - 1, 1)
 
     @property
     def scan_time(self) -> float:
@@ -110,6 +130,16 @@ LIDARS: dict[str, Lidar] = {
                'range (<= 3 m), 2 % (3-5 m), 2.5 % (5-25 m); 720 beams a turn as the '
                "TurtleBot 4's driver publishes them (estimated); dropouts, mixed pixels, "
                'latency, jitter and loss estimated', no_return=math.inf),
+    'lms111': Lidar(
+        'SICK LMS111', 541, 0.5, 20.0, 50.0, ((20.0, 0.024, 0.0),),
+        dropout=0.01, dark_runs=0.002, dark_run_length=6.0, mixed_pixels=0.5,
+        latency=0.01, jitter=0.003, scan_loss=0.005,
+        source='SICK LMS111-10100 datasheet: 270 degrees, 0.5 degree resolution at 50 Hz '
+               '(541 beams), 0.5-20 m, statistical error 12 mm (one sigma: +/-24 mm taken '
+               'as two), its systematic error (+/-30 mm, a fixed offset per unit) left out; '
+               'dropouts, mixed pixels (it takes one echo), latency over Ethernet, jitter '
+               'and loss estimated', no_return=math.inf, fov=math.radians(270.0),
+        angle_min=-math.radians(135.0)),
 }
 
 
@@ -126,6 +156,9 @@ def corrupt(ranges: NDArray[np.float64], lidar: Lidar,
     if lidar.mixed_pixels > 0.0 and n > 1:
         for shift in (1, -1):   # each beam against the next and the previous one
             other = np.roll(r, shift)
+            if lidar.fov < 2.0 * math.pi - 1e-9:   # the first and last beams are no neighbours
+                end = 0 if shift == 1 else -1
+                other[end] = r[end]
             with np.errstate(invalid='ignore'):
                 edge = np.isfinite(r) & np.isfinite(other) & (np.abs(other - r) > MIXED_EDGE)
             hit = edge & (rng.random(n) < 0.5 * lidar.mixed_pixels)

@@ -1,9 +1,11 @@
-"""Headless PyBullet stand-in for a TurtleBot3 burger (ROS-free, seeded, fixed dt).
+"""Headless PyBullet simulator of one robot of core/robot.py (ROS-free, seeded, fixed dt).
 
-The robot is a real multibody (urdf/burger_standin.urdf) whose two wheels are
+The robot (``robot``: the burger by default) is a real multibody built from its
+description (sim/body.py: its footprint, wheels, casters, mass) whose two wheels are
 velocity-controlled from (v, w): slip and acceleration are what PyBullet's
-contact model gives. The lidar is a 2-D scanner made with ``rayTestBatch``
-(360 beams from angle 0, 0.12 to 3.5 m, no-return beams as +inf) and, by
+contact model gives. The lidar is a 2-D scanner made with ``rayTestBatch`` at the
+description's mounting, with its lidar's beams, field of view and ranges (the
+burger's LDS-01: 360 beams from angle 0, 0.12 to 3.5 m) and, by
 default, as imperfect as the datasheet of the robot's lidar says (sim/sensor.py):
 range noise growing with range, beams dropped at random and in runs, mixed
 pixels at depth edges, and each beam cast at its own instant of the sweep from
@@ -13,8 +15,8 @@ is the base's motion, optionally with the systematic error of wheel odometry
 (distance and turn-rate scales) and noise; the ground truth is kept apart for
 scoring. The simulator's odom frame is the world frame at the start.
 
-Like the real burger's base, a command older than ``cmd_timeout`` of simulated
-time is replaced by zero velocity (the watchdog).
+Like a real base, a command older than ``cmd_timeout`` of simulated time is
+replaced by zero velocity (the watchdog).
 
 Moving obstacles (world ``moving``) are kinematic bodies placed where their
 paths put them at every physics step: the laser sees them and any contact with
@@ -27,7 +29,6 @@ from __future__ import annotations
 from collections.abc import Iterator
 import contextlib
 from dataclasses import dataclass
-from importlib import resources
 import math
 import os
 import sys
@@ -37,14 +38,13 @@ import pybullet
 from pybullet_utils.bullet_client import BulletClient
 
 from ..core.params import ConfigError, check_fields, param
-from ..core.robot import BURGER
+from ..core.robot import ROBOTS, RobotDescription
 from ..core.scan import Scan
+from .body import urdf_file, wheel_speeds
 from .sensor import LIDARS, Lidar, corrupt
 from .world import Box, Circle, World
 
 OBSTACLE_HEIGHT = 0.5
-#: The robot the URDF models (test/test_robot.py checks the two agree).
-ROBOT = BURGER
 
 
 @contextlib.contextmanager
@@ -63,8 +63,12 @@ def _quiet_stdout() -> Iterator[None]:
 
 @dataclass(frozen=True)
 class SimConfig:
-    """Simulator settings (SI units). Defaults: the burger and its LDS-01 in Gazebo."""
+    """Simulator settings (SI units). Defaults: the burger and its LDS-01; a setting at 0
+    (or '') is the robot's or its lidar's own."""
 
+    robot: str = param('burger', 'The robot simulated (core/robot.py ROBOTS: its footprint, '
+                       'wheels, lidar and limits; config/robots/ has its planner parameters)',
+                       choices=tuple(ROBOTS), read_only=True)
     physics_dt: float = param(0.005, 'Physics time step', 's', 1e-4, 0.05, read_only=True)
     solver_iterations: int = param(50, "PyBullet's constraint-solver iterations per physics "
                                    'step (its default, 50; fewer is faster and the wheels '
@@ -74,17 +78,20 @@ class SimConfig:
                               '(0: all cores; the ranges are the same for any number: '
                               'subapf-bench, one process per core, uses 1)', '', 0, 64,
                               read_only=True)
-    scan_beams: int = param(360, 'Lidar beams per sweep (LDS-01: 360)', '', 1, 4096,
-                            read_only=True)
-    range_min: float = param(0.12, 'Lidar minimum range', 'm', 0.0, 1.0, read_only=True)
-    range_max: float = param(3.5, 'Lidar maximum range', 'm', 0.1, 100.0, read_only=True)
+    scan_beams: int = param(0, "Lidar beams per sweep over its field of view (0: the "
+                            "lidar's own, the LDS-01's 360)", '', 0, 4096, read_only=True)
+    range_min: float = param(0.0, "Lidar minimum range (0: the lidar's own)", 'm', 0.0, 1.0,
+                             read_only=True)
+    range_max: float = param(0.0, "Lidar maximum range (0: the lidar's own)", 'm', 0.0,
+                             100.0, read_only=True)
     sensor: str = param('realistic', 'Lidar model: realistic (the datasheet errors of '
                         '`lidar`, each beam at its own instant of the sweep, latency and '
                         'lost scans: sim/sensor.py) or ideal (exact rays at one instant, '
                         'plus range_noise and beam_dropout)', choices=('ideal', 'realistic'),
                         read_only=True)
-    lidar: str = param('lds01', "Whose datasheet the realistic sensor follows (the burger's "
-                       'LDS-01; sim/sensor.py LIDARS)', choices=tuple(LIDARS), read_only=True)
+    lidar: str = param('', "The lidar simulated: its beams, field of view, rate and "
+                       "datasheet errors (sim/sensor.py LIDARS; '': the robot's own, the "
+                       "burger's LDS-01)", choices=('', *LIDARS), read_only=True)
     range_noise: float = param(0.0, 'Extra lidar range noise sigma on top of the sensor '
                                "model (the bench's faults)", 'm', 0.0, 1.0, read_only=True)
     beam_dropout: float = param(0.0, 'Extra fraction of beams dropped (reported +inf) on top '
@@ -99,38 +106,68 @@ class SimConfig:
                                   '(1 + e_r) / (1 + e_b) for a wheel radius error e_r and '
                                   'a wheel separation error e_b', '', 0.5, 1.5,
                                   read_only=True)
-    max_linear_velocity: float = param(ROBOT.max_linear_velocity, 'Base speed limit', 'm/s',
+    max_linear_velocity: float = param(0.0, "Base speed limit (0: the robot's)", 'm/s',
                                        0.0, 5.0, read_only=True)
-    max_angular_velocity: float = param(ROBOT.max_angular_velocity, 'Base turn-rate limit',
+    max_angular_velocity: float = param(0.0, "Base turn-rate limit (0: the robot's)",
                                         'rad/s', 0.0, 20.0, read_only=True)
-    wheel_torque: float = param(0.5, 'Wheel motor torque limit', 'N m', 1e-3, 100.0,
-                                read_only=True)
+    wheel_torque: float = param(0.0, "Wheel motor torque limit (0: the robot's)", 'N m',
+                                0.0, 100.0, read_only=True)
     cmd_timeout: float = param(0.5, 'Base watchdog: zero velocity after this without a '
                                'command', 's', 0.05, 10.0, read_only=True)
     seed: int = param(0, 'Random seed of all noise', '', 0, 2**31 - 1, read_only=True)
 
     def __post_init__(self) -> None:
         check_fields(self)
-        if self.range_min >= self.range_max:
-            raise ConfigError(f'range_min: {self.range_min} must be below range_max '
-                              f'{self.range_max}')
+        low, high = self.ranges
+        if low >= high:
+            raise ConfigError(f'range_min: {low} must be below range_max {high}')
+
+    @property
+    def description(self) -> RobotDescription:
+        """The robot simulated."""
+        return ROBOTS[self.robot]
 
     @property
     def model(self) -> Lidar:
-        """The lidar whose errors and timing the realistic sensor has."""
-        return LIDARS[self.lidar]
+        """The lidar simulated: its beams, field of view, timing and errors."""
+        return LIDARS[self.lidar or self.description.lidar]
+
+    @property
+    def beams(self) -> int:
+        """Beams per sweep."""
+        return self.scan_beams or self.model.beams
+
+    @property
+    def ranges(self) -> tuple[float, float]:
+        """The lidar's (minimum, maximum) range [m]."""
+        return (self.range_min or self.model.range_min, self.range_max or self.model.range_max)
+
+    @property
+    def limits(self) -> tuple[float, float]:
+        """The base's (speed [m/s], turn rate [rad/s]) limits."""
+        robot = self.description
+        return (self.max_linear_velocity or robot.max_linear_velocity,
+                self.max_angular_velocity or robot.max_angular_velocity)
+
+    @property
+    def torque(self) -> float:
+        """The wheel motors' torque limit [N m]."""
+        return self.wheel_torque or self.description.body.wheel_torque
 
     @property
     def realistic(self) -> bool:
         return self.sensor == 'realistic'
 
 
-class BurgerSim:
+class RobotSim:
     """One world, one robot, fixed-step physics. Not thread-safe."""
 
     def __init__(self, world: World, config: SimConfig | None = None) -> None:
         self.world = world
         self.config = config or SimConfig()
+        #: The robot simulated, and its lidar.
+        self.robot = self.config.description
+        self.lidar = self.config.model
         self._rng = np.random.default_rng(self.config.seed)
         with _quiet_stdout():
             self._client = BulletClient(connection_mode=pybullet.DIRECT)
@@ -147,8 +184,8 @@ class BurgerSim:
         #: The odometry pose; None: the true pose (perfect odometry once it moved).
         self._odom: np.ndarray | None = np.array([x, y, yaw])
         self._truth_prev = self.true_pose()
-        n = self.config.scan_beams
-        self._angles = 2.0 * math.pi * np.arange(n) / n
+        n = self.config.beams
+        self._angles = self.lidar.angles(n)
         #: The sweep being taken: its start [s], beams cast so far, their true ranges;
         #: and the sweeps completed since the last ``sweeps()``.
         self._sweep_t0 = 0.0
@@ -173,17 +210,16 @@ class BurgerSim:
         self._movers = [self._add_obstacle(o) for o in self.world.moving_at(0.0)]
         self._mover_orn = [c.getBasePositionAndOrientation(b)[1] for b in self._movers]
         x, y, yaw = self.world.start
-        with resources.as_file(resources.files(__package__) / 'urdf'
-                               / 'burger_standin.urdf') as urdf:
-            self.robot = c.loadURDF(str(urdf), [x, y, 0.001],
-                                    c.getQuaternionFromEuler([0, 0, yaw]))
-        c.changeDynamics(self.robot, -1, lateralFriction=0.0, spinningFriction=0.0,
+        with urdf_file(self.robot) as urdf:
+            self.body = c.loadURDF(str(urdf), [x, y, 0.001],
+                                   c.getQuaternionFromEuler([0, 0, yaw]))
+        c.changeDynamics(self.body, -1, lateralFriction=0.0, spinningFriction=0.0,
                          rollingFriction=0.0)
-        names = {c.getJointInfo(self.robot, j)[1].decode(): j
-                 for j in range(c.getNumJoints(self.robot))}
+        names = {c.getJointInfo(self.body, j)[1].decode(): j
+                 for j in range(c.getNumJoints(self.body))}
         self._wheels = (names['wheel_left_joint'], names['wheel_right_joint'])
         for j in self._wheels:
-            c.changeDynamics(self.robot, j, lateralFriction=1.0)
+            c.changeDynamics(self.body, j, lateralFriction=1.0)
 
     def _add_obstacle(self, o: Circle | Box) -> int:
         c = self._client
@@ -204,7 +240,7 @@ class BurgerSim:
             self._client.disconnect()
             self._client = None
 
-    def __enter__(self) -> 'BurgerSim':
+    def __enter__(self) -> 'RobotSim':
         return self
 
     def __exit__(self, *exc: object) -> None:
@@ -212,12 +248,10 @@ class BurgerSim:
 
     # --- commands and stepping ----------------------------------------------------------
     def set_command(self, v: float, w: float) -> None:
-        """Velocity command [m/s, rad/s], clamped to the burger's limits; NaN -> 0."""
-        cfg = self.config
-        v = 0.0 if not math.isfinite(v) else max(-cfg.max_linear_velocity,
-                                                 min(cfg.max_linear_velocity, v))
-        w = 0.0 if not math.isfinite(w) else max(-cfg.max_angular_velocity,
-                                                 min(cfg.max_angular_velocity, w))
+        """Velocity command [m/s, rad/s], clamped to the base's limits; NaN -> 0."""
+        v_max, w_max = self.config.limits
+        v = 0.0 if not math.isfinite(v) else max(-v_max, min(v_max, v))
+        w = 0.0 if not math.isfinite(w) else max(-w_max, min(w_max, w))
         self._cmd = (v, w)
         self._cmd_time = self.time
 
@@ -230,13 +264,11 @@ class BurgerSim:
     def _apply_wheels(self) -> None:
         """The wheel motors' target velocities for the base's (v, w), sent when they
         change (PyBullet keeps a motor's target until it is set again)."""
-        v, w = self.wheel_command()
-        targets = ((v - w * ROBOT.wheel_separation / 2) / ROBOT.wheel_radius,
-                   (v + w * ROBOT.wheel_separation / 2) / ROBOT.wheel_radius)
+        targets = wheel_speeds(self.robot, *self.wheel_command())
         if targets != self._wheels_sent:
             pybullet.setJointMotorControlArray(
-                self.robot, list(self._wheels), pybullet.VELOCITY_CONTROL,
-                targetVelocities=list(targets), forces=[self.config.wheel_torque] * 2,
+                self.body, list(self._wheels), pybullet.VELOCITY_CONTROL,
+                targetVelocities=list(targets), forces=[self.config.torque] * 2,
                 physicsClientId=self._cid)
             self._wheels_sent = targets
 
@@ -284,7 +316,7 @@ class BurgerSim:
     def _touching_obstacle(self) -> bool:
         plane = self._plane
         return any(cp[2] != plane
-                   for cp in pybullet.getContactPoints(self.robot, physicsClientId=self._cid))
+                   for cp in pybullet.getContactPoints(self.body, physicsClientId=self._cid))
 
     @property
     def _perfect_odometry(self) -> bool:
@@ -295,13 +327,13 @@ class BurgerSim:
     # --- state --------------------------------------------------------------------------
     def true_pose(self) -> np.ndarray:
         """Ground-truth (x, y, yaw) of base_footprint in the world frame."""
-        pos, orn = pybullet.getBasePositionAndOrientation(self.robot, physicsClientId=self._cid)
+        pos, orn = pybullet.getBasePositionAndOrientation(self.body, physicsClientId=self._cid)
         yaw = pybullet.getEulerFromQuaternion(orn)[2]
         return np.array([pos[0], pos[1], yaw])
 
     def true_velocity(self) -> tuple[float, float]:
         """Ground-truth forward speed [m/s] and yaw rate [rad/s] in the body frame."""
-        lin, ang = pybullet.getBaseVelocity(self.robot, physicsClientId=self._cid)
+        lin, ang = pybullet.getBaseVelocity(self.body, physicsClientId=self._cid)
         yaw = self.true_pose()[2]
         return lin[0] * math.cos(yaw) + lin[1] * math.sin(yaw), ang[2]
 
@@ -343,35 +375,37 @@ class BurgerSim:
         n = a.size
         if poses is None:
             poses = np.tile(self.true_pose(), (n, 1))
-        mx, my, myaw = ROBOT.laser.planar
+        mx, my, myaw = self.robot.laser.planar
         c, s = np.cos(poses[:, 2]), np.sin(poses[:, 2])
         origin = np.column_stack((poses[:, 0] + c * mx - s * my, poses[:, 1] + s * mx + c * my,
-                                  np.full(n, ROBOT.laser.z)))
+                                  np.full(n, self.robot.laser.z)))
         a = a + poses[:, 2] + myaw
-        ends = origin + cfg.range_max * np.column_stack((np.cos(a), np.sin(a), np.zeros(n)))
+        reach = cfg.ranges[1]
+        ends = origin + reach * np.column_stack((np.cos(a), np.sin(a), np.zeros(n)))
         hits = pybullet.rayTestBatch(origin.tolist(), ends.tolist(),
                                      numThreads=cfg.scan_threads, physicsClientId=self._cid)
-        return np.array([h[2] if h[0] >= 0 else np.inf for h in hits]) * cfg.range_max
+        return np.array([h[2] if h[0] >= 0 else np.inf for h in hits]) * reach
 
     def _reported(self, true: np.ndarray) -> np.ndarray:
         """The ranges the lidar reports for the true ones: the sensor model's errors
         (realistic), the extra noise and dropout, +inf outside [range_min, range_max)."""
         cfg = self.config
-        ranges = corrupt(true, cfg.model, self._rng) if cfg.realistic else true.copy()
+        ranges = corrupt(true, self.lidar, self._rng) if cfg.realistic else true.copy()
         n = ranges.size
         if cfg.range_noise > 0.0:
             ranges = ranges + cfg.range_noise * self._rng.standard_normal(n)
         if cfg.beam_dropout > 0.0:
             ranges[self._rng.random(n) < cfg.beam_dropout] = np.inf
-        ranges[(ranges < cfg.range_min) | (ranges >= cfg.range_max)] = \
-            cfg.model.no_return if cfg.realistic else np.inf
+        low, high = cfg.ranges
+        ranges[(ranges < low) | (ranges >= high)] = \
+            self.lidar.no_return if cfg.realistic else np.inf
         return ranges
 
     def _advance_sweep(self) -> None:
         """Cast the beams of the sweep in progress whose instants have come (all at its
         start with the ideal sensor), and complete it when its last beam is cast."""
         cfg = self.config
-        n, period = cfg.scan_beams, cfg.model.scan_time
+        n, period = cfg.beams, self.lidar.scan_time
         inc = period / n if cfg.realistic else 0.0
         tau = self.time - self._sweep_t0
         if tau < -1e-9:
@@ -394,9 +428,8 @@ class BurgerSim:
         self._stepped_from = (t1, p1)
         if due < n:
             return
-        self._swept.append(Scan(self._reported(self._sweep_true), 0.0, 2.0 * math.pi / n,
-                                cfg.range_min, cfg.range_max, stamp=self._sweep_t0,
-                                time_increment=inc, scan_time=period))
+        self._swept.append(Scan(self._reported(self._sweep_true), *self._geometry(),
+                                stamp=self._sweep_t0, time_increment=inc, scan_time=period))
         self._sweep_t0 += period
         self._sweep_cast = 0
         self._sweep_true = np.full(n, np.inf)
@@ -416,7 +449,11 @@ class BurgerSim:
     def scan(self) -> Scan:
         """One sweep from base_scan cast now, at the current pose, with the sensor's
         range errors but no sweep timing (+inf: no return)."""
-        cfg = self.config
-        n = cfg.scan_beams
-        return Scan(self._reported(self._cast(slice(0, n))), 0.0, 2.0 * math.pi / n,
-                    cfg.range_min, cfg.range_max, stamp=self.time)
+        return Scan(self._reported(self._cast(slice(0, self.config.beams))),
+                    *self._geometry(), stamp=self.time)
+
+    def _geometry(self) -> tuple[float, float, float, float]:
+        """A scan's angle_min, angle_increment [rad], range_min, range_max [m]."""
+        a = self._angles
+        increment = float(a[1] - a[0]) if a.size > 1 else self.lidar.angle_increment
+        return (float(a[0]), increment, *self.config.ranges)

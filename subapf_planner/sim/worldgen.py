@@ -22,6 +22,13 @@ is BASE_TIME + TIME_FACTOR x geodesic length / MAX_SPEED [s], the geodesic being
 the shortest 8-connected path through the free cells (at most 8 % longer than
 the true shortest path).
 
+For another robot (``robot``, core/robot.py) each world is the burger's, scaled
+(``scale_world``): every length by the ratio of the robot's solve radius (its
+circumscribed radius plus SOLVE_MARGIN) to the burger's, so a gap the burger's disc just
+passes is one the robot's circumscribed disc just passes; the moving obstacles' speeds
+by the ratio of the top speeds (as DynaBARN scales its movers to the Jackal's); the time
+limit from the scaled geodesic at the robot's top speed. The goal tolerance stays.
+
 The building family (sim/building.py) is a suite of its own (``--families
 building``). The dynamic families (sim/dynamic_families.py) are checked the same way on their
 static obstacles (moving ones are not walls: they pass); in addition no moving
@@ -40,6 +47,7 @@ import zlib
 
 import numpy as np
 
+from ..core.robot import BURGER, RobotDescription
 from .building import BUILDING_BUILDERS, BUILDING_FAMILIES, BUILDING_RANGES
 from .dynamic_families import DYNAMIC_BUILDERS, DYNAMIC_FAMILIES, DYNAMIC_RANGES
 from .families import BUILDERS, FAMILIES, RANGES, FamilyRanges, Layout, circle
@@ -175,9 +183,62 @@ def _layout(family: str, rng: np.random.Generator, ranges: FamilyRanges) -> Layo
     return BUILDING_BUILDERS[family](rng, BUILDING_RANGES)
 
 
-def time_limit(geodesic: float) -> int:
-    """Simulated time allowed for a world whose geodesic is ``geodesic`` m long [s]."""
-    return math.ceil(BASE_TIME + TIME_FACTOR * geodesic / MAX_SPEED)
+def time_limit(geodesic: float, top_speed: float = MAX_SPEED) -> int:
+    """Simulated time allowed for a world whose geodesic is ``geodesic`` m long, for a
+    robot of ``top_speed`` [m/s] [s]."""
+    return math.ceil(BASE_TIME + TIME_FACTOR * geodesic / top_speed)
+
+
+def scale_world(world: GeneratedWorld, robot: RobotDescription) -> GeneratedWorld:
+    """The burger's ``world`` for ``robot`` (module docstring): lengths times the ratio
+    of solve radii, moving obstacles' speeds times the ratio of top speeds. The burger's
+    world is returned as it is."""
+    if robot == BURGER:
+        return world
+    size = robot.solve_radius / BURGER.solve_radius
+    pace = robot.max_linear_velocity / BURGER.max_linear_velocity
+
+    def length(v: float) -> float:
+        return _as_written(v * size)
+
+    def points(values: list[float]) -> list[float]:
+        return [length(v) for v in values]
+
+    doc = dict(world.doc)
+    doc['start'] = [*points(doc['start'][:2]), doc['start'][2]]
+    doc['goal'] = points(doc['goal'])
+    doc['bounds'] = points(doc['bounds'])
+    obstacles = []
+    for o in doc['obstacles']:
+        if 'circle' in o:
+            c = o['circle']
+            obstacles.append(circle(*points(c['center']), length(c['radius'])))
+        else:
+            b = o['box']
+            obstacles.append({'box': {**b, 'center': points(b['center']),
+                                      'size': points(b['size'])}})
+    doc['obstacles'] = obstacles
+    if 'moving' in doc:
+        moving = []
+        for m in doc['moving']:
+            shape = 'circle' if 'circle' in m else 'box'
+            spec = dict(m[shape])
+            if shape == 'circle':
+                spec['radius'] = length(spec['radius'])
+            else:
+                spec['size'] = points(spec['size'])
+            # lengths times size and speeds times pace: times times size / pace
+            moving.append({**m, shape: spec,
+                           'path': [[_as_written(t * size / pace), *points([x, y])]
+                                    for t, x, y in m['path']],
+                           **({'offset': _as_written(m['offset'] * size / pace)}
+                              if 'offset' in m else {})})
+        doc['moving'] = moving
+    geodesic = world.geodesic_length * size
+    doc['time_limit'] = time_limit(geodesic, robot.max_linear_velocity)
+    doc['description'] = (f'{doc["description"]}; scaled x{size:.3f} in length and '
+                          f'x{pace:.3f} in speed for the {robot.name}')
+    return GeneratedWorld(doc, world.family, world.seed, world.attempt, geodesic)
 
 
 def generate_world(family: str, seed: int, name: str | None = None,
@@ -230,11 +291,12 @@ def sub_seed(seed: int, family: str, index: int) -> int:
     return int(ss.generate_state(1, np.uint32)[0])
 
 
-def suite_worlds(count: int, seed: int,
-                 families: tuple[str, ...] = FAMILIES) -> list[GeneratedWorld]:
+def suite_worlds(count: int, seed: int, families: tuple[str, ...] = FAMILIES,
+                 robot: RobotDescription = BURGER) -> list[GeneratedWorld]:
     """``count`` worlds, world i of family ``families[i % len(families)]``, named
     ``<family>_<index in the family, 3 digits>`` and drawn from
-    ``sub_seed(seed, family, index)``: a world depends on (seed, family, index) only."""
+    ``sub_seed(seed, family, index)``: a world depends on (seed, family, index) only;
+    for another ``robot`` than the burger, scaled for it (scale_world)."""
     if count < 1:
         raise ValueError(f'count must be at least 1, got {count}')
     if not families:
@@ -244,8 +306,8 @@ def suite_worlds(count: int, seed: int,
     out = []
     for i in range(count):
         family, index = families[i % len(families)], i // len(families)
-        out.append(generate_world(family, sub_seed(seed, family, index),
-                                  f'{family}_{index:03d}'))
+        out.append(scale_world(generate_world(family, sub_seed(seed, family, index),
+                                              f'{family}_{index:03d}'), robot))
     return out
 
 

@@ -5,9 +5,11 @@ Every (world, method) run steps the simulator and the node's decision loop in
 lockstep in one process (sim/episode.py); ``--jobs`` spreads the worlds over
 processes, each drawing its world's Fig. 6-style PNG, and ``--cluster`` over the
 workers of a Dask distributed cluster (the same results.json but the timings).
-Writes ``results.json``, ``summary.md`` and the PNGs to --out. One parameter file (default: the
-package's config/planner.yaml) for all worlds; a method may name its attraction
-field (``subharmonic_sampling:euclidean`` is the paper's method exactly).
+Writes ``results.json``, ``summary.md`` and the PNGs to --out. One robot (``--robot``,
+core/robot.py: the simulator's body, wheels and lidar) and one parameter file (default:
+the package's config/planner.yaml with the robot's config/robots/ file on top) for all
+worlds; a method may name its attraction field (``subharmonic_sampling:euclidean`` is
+the paper's method exactly).
 results.json's ``meta`` says how it was produced (command line, package version, git
 commit, date): ``subapf-results`` puts it under the tables of docs/results.md.
 """
@@ -35,8 +37,9 @@ import time
 import numpy as np
 from tqdm import tqdm
 
-from ..core.config import METHODS, ConfigError, load_config
-from ..ros.paths import default_params_file, shipped_worlds_dir
+from ..core.config import METHODS, ConfigError, PlannerConfig, load_config, load_params_file
+from ..core.robot import BURGER, ROBOTS, RobotDescription
+from ..ros.paths import default_params_file, robot_params_file, shipped_worlds_dir
 from ..sim.episode import run_episode
 from ..sim.faults import ScanFaults
 from ..sim.simulator import SimConfig
@@ -81,18 +84,18 @@ def _index(path: Path) -> dict[str, float]:
     return found
 
 
-def shortest_path(world: World) -> float:
+def shortest_path(world: World, robot: RobotDescription = BURGER) -> float:
     """The world's shortest path from start to goal [m]: the smoothed length an INDEX
     beside its file gives, else the geodesic of sim/solvability.py (8-connected cells of
-    5 cm, a disc of the burger's footprint plus margin: up to 8 % longer than the true
-    shortest path, so the ratios below come out up to that much low); inf when there is
-    no way."""
+    5 cm, a disc of the robot's circumscribed radius plus margin: up to 8 % longer than
+    the true shortest path, so the ratios below come out up to that much low); inf when
+    there is no way."""
     index = Path(world.source).parent / INDEX
     if index.is_file():
         length = _index(index).get(world.name)
         if length is not None:
             return length
-    return geodesic_length(world)
+    return geodesic_length(world, robot.solve_radius)
 
 
 def efficiency(record: dict, shortest: float, top_speed: float) -> dict:
@@ -127,7 +130,7 @@ def _run_world(job: tuple) -> list[tuple[dict, list]]:
     """All methods on one world (in a worker), and its plot when ``plot_dir`` is set."""
     world, methods, cfg, sim_cfg, faults, plot_dir, animate, known = job
     out = []
-    shortest = shortest_path(world)
+    shortest = shortest_path(world, sim_cfg.description)
     known_map = world_map(world) if known else None
     for spec in methods:
         run_cfg = cfg.replace(**parse_method(spec))
@@ -329,6 +332,19 @@ def provenance(argv: list[str]) -> dict:
             'date': datetime.date.today().isoformat()}
 
 
+def bench_config(params: str | None, robot: str | None) -> tuple[str, PlannerConfig]:
+    """The robot's key and the planner's configuration for the bench: the params file
+    (default config/planner.yaml), with the robot's config/robots/ file on top unless the
+    params file is written for that robot (its ``robot``); the robot: ``robot``, else the
+    params file's, else the burger. ConfigError when a file cannot be read."""
+    path = params or default_params_file()
+    named = load_params_file(path).get('robot')
+    key = robot or (named if named in ROBOTS else 'burger')
+    if named == key:
+        return key, load_config(path)
+    return key, load_config(path, **load_params_file(robot_params_file(key)))
+
+
 def parse_args(argv: list[str] | None) -> argparse.Namespace:
     p = argparse.ArgumentParser(prog='subapf-bench', description=__doc__.splitlines()[0])
     p.add_argument('worlds', nargs='*', help='world files or directories (default: shipped)')
@@ -336,6 +352,10 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
                    help='comma-separated method[:geodesic|:euclidean] (attraction field; '
                    f'default: the params file\'s), of {",".join(METHODS)}')
     p.add_argument('--out', required=True, help='output directory')
+    p.add_argument('--robot', choices=sorted(ROBOTS), default=None,
+                   help="the robot simulated and planned for (core/robot.py; default: the "
+                   "params file's robot, else the burger); its config/robots/ file goes "
+                   'on top of the params file unless that is written for it (robot: NAME)')
     p.add_argument('--params', default=None, help='ROS 2 params YAML (config/planner.yaml)')
     p.add_argument('--jobs', type=int, default=1, help='worker processes')
     p.add_argument('--cluster', default=None, metavar='ADDRESS',
@@ -381,12 +401,13 @@ def main(argv: list[str] | None = None) -> int:
             raise ValueError('no method given')
         for m in methods:
             parse_method(m)
-        cfg = load_config(args.params or default_params_file())
+        robot, cfg = bench_config(args.params, args.robot)
         if args.faults:
             for name, value in FOUR_FAULTS.items():
                 if getattr(args, name) == 0.0:
                     setattr(args, name, value)
-        sim_cfg = SimConfig(seed=args.seed, sensor=args.sensor, range_noise=args.noise,
+        sim_cfg = SimConfig(robot=robot, seed=args.seed, sensor=args.sensor,
+                            range_noise=args.noise,
                             beam_dropout=args.beam_dropout,
                             odom_distance_scale=args.odom_scale,
                             odom_yaw_scale=args.odom_yaw_scale,
@@ -422,7 +443,8 @@ def main(argv: list[str] | None = None) -> int:
     runs = [r for world_runs in per_world for r, _ in world_runs]
     labels = list(dict.fromkeys(r['method'] for r in runs))
     doc = {'meta': provenance(argv),
-           'runs': runs, 'methods': labels, 'seed': args.seed, 'sensor': args.sensor,
+           'runs': runs, 'methods': labels, 'robot': robot, 'seed': args.seed,
+           'sensor': args.sensor,
            'noise': args.noise,
            'beam_dropout': args.beam_dropout, 'scan_dropout': args.scan_dropout,
            'scan_latency': args.scan_latency, 'odom_distance_scale': args.odom_scale,

@@ -31,7 +31,8 @@ import numpy as np
 
 from ..core.config import METHODS, ConfigError, load_params_file
 from ..core.params import build
-from ..ros.paths import default_params_file
+from ..core.robot import ROBOTS
+from ..ros.paths import default_params_file, robot_params_file
 from ..ros.processes import free_domain, join_domain, start, stop
 from ..sim.metrics import path_length
 from ..sim.world import World, WorldError, load_world
@@ -41,9 +42,8 @@ PROG = 'subapf-bringup'
 DOMAIN_IDS = range(0, 102)
 #: ROS_DOMAIN_ID may be any domain Fast DDS's default port mapping allows.
 ENV_DOMAIN_IDS = range(0, 233)
-#: The robot the simulator is (sim/simulator.py: the burger), and its laser frame.
+#: The robot simulated when neither --robot nor the params file names one.
 SIM_ROBOT = 'burger'
-SIM_LASER_FRAME = 'base_scan'
 
 
 class BringupError(Exception):
@@ -55,15 +55,19 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
         prog=PROG, description=' '.join(__doc__.split('\n\n')[1].replace('``', '').split()),
         epilog="Defaults: the planner's parameters are the package's config/planner.yaml "
         f'({_default_params()}) unless --params names another file (its '
-        '"subapf_planner:" section, checked before anything starts; a robot file of '
-        'config/robots/ alone works too, for the burger, the one robot the simulator can '
-        "be); the simulator's are the code's (subapf-sim --help), with --rate, --seed and "
-        '--noise. Example: subapf-bringup --world sim/worlds/fig6d_big_wall.yaml --rate 5')
+        '"subapf_planner:" section, checked before anything starts), with the robot\'s '
+        'config/robots/ file on top unless the params file is written for it (robot: '
+        "NAME); the simulator is that robot, with the code's parameters (subapf-sim "
+        '--help), --rate, --seed and --noise. Example: subapf-bringup --world '
+        'sim/worlds/fig6d_big_wall.yaml --rate 5')
     p.add_argument('--world', required=True, help='world file (format v1, docs/worlds.md)')
     p.add_argument('--method', default=None, choices=METHODS,
                    help="override the params file's method")
     p.add_argument('--params', default=None,
                    help="planner params YAML (default: the package's config/planner.yaml)")
+    p.add_argument('--robot', default=None, choices=sorted(ROBOTS),
+                   help="the robot simulated and planned for (default: the params file's "
+                   'robot, else the burger)')
     p.add_argument('--rate', type=float, default=1.0,
                    help='simulation speed-up, in [0.1, 100] (default: 1, real time)')
     p.add_argument('--record', default=None, help='write an MCAP bag of the run')
@@ -100,31 +104,36 @@ def one_line(exc: BaseException) -> str:
     return ' '.join(str(exc).split())
 
 
-def check_params(path: str) -> dict:
-    """The planner's values in the params file ``path``, checked as the planner would
-    check them, and that the simulator can be the robot they describe (BringupError,
-    one line, otherwise)."""
+def check_params(path: str, robot: str | None = None) -> tuple[dict, str, tuple[str, ...]]:
+    """The planner's values from the params file ``path`` and, unless it is written for
+    the robot (its ``robot``), the robot's config/robots/ file on top, checked as the
+    planner would check them; the robot simulated (``robot``, else the params file's,
+    else the burger) and the params files in the order the planner loads them
+    (BringupError, one line, when they cannot serve that robot)."""
     from ..ros.planner_node import GROUPS, OTHER_ROBOT
     try:
         values = load_params_file(path, 'subapf_planner')
+        named = values.get('robot', SIM_ROBOT)
+        if robot is None and named == OTHER_ROBOT:
+            raise BringupError(f'{path} is for a robot of your own (robot: {OTHER_ROBOT}), '
+                               'which the simulator cannot be; give --robot (one of '
+                               f'{", ".join(ROBOTS)})')
+        key = robot or (named if named in ROBOTS else SIM_ROBOT)
+        files: tuple[str, ...] = (path,)
+        if named != key:
+            files = (path, str(robot_params_file(key)))
+            values = {**values, **load_params_file(files[1], 'subapf_planner')}
         for cls in GROUPS:
             build(cls, values, ignore_unknown=True)
     except ConfigError as exc:
         text = one_line(exc)
         raise BringupError(text if text.startswith(str(path)) else f'{path}: {text}') from exc
-    robot = values.get('robot', SIM_ROBOT)
-    if robot not in (SIM_ROBOT, OTHER_ROBOT):
+    laser, frame = values.get('laser_frame', ROBOTS[key].laser_frame), ROBOTS[key].laser_frame
+    if laser not in (frame, ''):
         raise BringupError(
-            f'{path} is for the {robot} (robot: {robot}), but the simulator can only be a '
-            f'TurtleBot3 burger (a simulated {robot} is not there yet); give a burger '
-            'params file (config/planner.yaml or config/robots/burger.yaml)')
-    laser = values.get('laser_frame', SIM_LASER_FRAME)
-    if laser not in (SIM_LASER_FRAME, ''):
-        raise BringupError(
-            f'{path}: laser_frame is {laser}, but the simulator (a TurtleBot3 burger) '
-            f'sends its scans in {SIM_LASER_FRAME}: the planner would drop every one; set '
-            f'laser_frame: {SIM_LASER_FRAME}')
-    return values
+            f'{path}: laser_frame is {laser}, but the simulator (the {key}) sends its '
+            f'scans in {frame}: the planner would drop every one; set laser_frame: {frame}')
+    return values, key, files
 
 
 def choose_domain(args: argparse.Namespace, environ: Mapping[str, str]) -> tuple[int, str]:
@@ -175,10 +184,13 @@ class Plan:
 
     world: World
     world_path: str
-    params: str
+    #: The planner's params files, in the order it loads them.
+    params: tuple[str, ...]
     method: str
     domain: int
     domain_source: str
+    #: The robot simulated (core/robot.py ROBOTS).
+    robot: str = SIM_ROBOT
 
 
 def prepare(args: argparse.Namespace, environ: Mapping[str, str]) -> Plan:
@@ -213,10 +225,10 @@ def prepare(args: argparse.Namespace, environ: Mapping[str, str]) -> Plan:
         raise BringupError(f'--params {args.params}: no such file')
     if args.params and not Path(params).is_file():
         raise BringupError(f'--params {args.params}: not a file')
-    values = check_params(params)
+    values, robot, files = check_params(params, args.robot)
     domain, source = choose_domain(args, environ)
     method = args.method or values.get('method', METHODS[0])
-    return Plan(world, sim['world'], params, method, domain, source)
+    return Plan(world, sim['world'], files, method, domain, source, robot)
 
 
 @dataclass(frozen=True)
@@ -231,26 +243,32 @@ class RunResult:
     rss_mib: dict[str, list[float]] = field(default_factory=dict)
 
 
-def run_once(world: World, world_path: str, params: str, domain: int, *,
+def run_once(world: World, world_path: str, params: str | tuple[str, ...], domain: int, *,
              method: str | None = None, rate: float = 1.0, seed: int = 0,
              sim_params: dict[str, float] | None = None, record: str | None = None,
              record_topics: list[str] | None = None, timeout: float | None = None,
-             log_dir: Path | None = None, foxglove_port: int | None = None) -> RunResult:
+             log_dir: Path | None = None, foxglove_port: int | None = None,
+             robot: str = SIM_ROBOT) -> RunResult:
     """Start both nodes on ``domain`` (and foxglove_node serving on ``foxglove_port``),
-    send the goal, wait for the outcome, stop them.
+    send the goal, wait for the outcome, stop them. ``params``: the planner's params
+    file, or files in the order it loads them; ``robot``: the robot simulated.
 
     The nodes' output goes to the terminal, or to ``log_dir``/{sim,planner,foxglove}.log.
     """
     env = join_domain(domain)
-    planner_args = ['--params-file', params, '-p', 'use_sim_time:=true']
+    files = (params,) if isinstance(params, str) else tuple(params)
+    planner_args = [arg for f in files for arg in ('--params-file', f)]
+    planner_args += ['-p', 'use_sim_time:=true']
     if method:
         planner_args += ['-p', f'method:={method}']
-    sim_args = ['-p', f'world:={world_path}', '-p', f'rate:={rate}', '-p', f'seed:={seed}']
+    stamped = str(ROBOTS[robot].stamped_cmd_vel).lower()   # the base takes what it takes
+    sim_args = ['-p', f'world:={world_path}', '-p', f'rate:={rate}', '-p', f'seed:={seed}',
+                '-p', f'robot:={robot}', '-p', f'enable_stamped_cmd_vel:={stamped}']
     for name, value in (sim_params or {}).items():
         sim_args += ['-p', f'{name}:={value}']
     timeout = timeout or 2.0 * world.time_limit / rate + 30.0
     if method is None:
-        method = load_params_file(params).get('method', METHODS[0])
+        method = load_params_file(files[0]).get('method', METHODS[0])
 
     from ..ros.supervisor import Supervisor  # rclpy only after the environment is set
     children: list[subprocess.Popen] = []
@@ -288,13 +306,13 @@ def main(argv: list[str] | None = None) -> int:
         print(f'{PROG}: error: {exc}', file=sys.stderr)
         return 2
     world = plan.world
-    print(f'{PROG}: world {world.name}, domain {plan.domain} ({plan.domain_source}), '
-          f'rate {args.rate}x', flush=True)
+    print(f'{PROG}: world {world.name}, robot {plan.robot}, domain {plan.domain} '
+          f'({plan.domain_source}), rate {args.rate}x', flush=True)
     result = run_once(world, plan.world_path, plan.params, plan.domain,
                       method=args.method, rate=args.rate, seed=args.seed,
                       sim_params={'range_noise': args.noise}, record=args.record,
                       record_topics=args.record_topics, timeout=args.timeout,
-                      foxglove_port=args.foxglove)
+                      foxglove_port=args.foxglove, robot=plan.robot)
     if result.outcome.startswith('failed: ') and 'did not start' in result.outcome:
         print(f'{PROG}: error: {result.outcome[len("failed: "):]}; its own message is '
               'above', file=sys.stderr)

@@ -51,11 +51,11 @@ VIEWS = (('markers', 'visualization_msgs.msg', 'MarkerArray'),
 def node_inputs() -> tuple:
     """The scan and odometry pose the measurements feed: the simulator's, standing in
     the shipped cluttered_field world (1 cm range noise)."""
-    from ..sim.simulator import BurgerSim, SimConfig
+    from ..sim.simulator import RobotSim, SimConfig
     from ..sim.world import load_world
 
     world = load_world(shipped_worlds_dir() / 'cluttered_field.yaml')
-    with BurgerSim(world, SimConfig(range_noise=0.01)) as sim:
+    with RobotSim(world, SimConfig(range_noise=0.01)) as sim:
         return sim.scan(), sim.odometry()[0]
 
 

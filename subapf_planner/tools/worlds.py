@@ -1,6 +1,7 @@
 """``subapf-worlds``: write a seeded suite of procedural worlds (format v1 YAML).
 
-``subapf-worlds --out DIR [--count 210] [--seed 2026] [--families barn,maze,...]``
+``subapf-worlds --out DIR [--count 210] [--seed 2026] [--families barn,maze,...]
+[--robot NAME]``
 (``--families dynamic``: every family with moving obstacles; ``--families
 building``: office floors, sim/building.py) writes
 DIR/<family>_<index>.yaml for each world of ``sim.worldgen.suite`` (the families
@@ -19,6 +20,7 @@ from typing import Any
 
 import yaml
 
+from ..core.robot import ROBOTS
 from ..sim.worldgen import ALL_FAMILIES, DYNAMIC_FAMILIES, FAMILIES, suite_worlds
 
 PROG = 'subapf-worlds'
@@ -67,6 +69,9 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
     p.add_argument('--families', default=','.join(FAMILIES),
                    help=f'comma-separated, of {",".join(ALL_FAMILIES)}; "dynamic" for '
                    f'{",".join(DYNAMIC_FAMILIES)} (default: the static {",".join(FAMILIES)})')
+    p.add_argument('--robot', default='burger', choices=sorted(ROBOTS),
+                   help="the robot the worlds are for: the burger's worlds scaled to its "
+                   "size and speed (sim/worldgen.py scale_world; default: the burger)")
     return p.parse_args(argv)
 
 
@@ -99,7 +104,7 @@ def main(argv: list[str] | None = None) -> int:
         print(f'{PROG}: cannot create {out}: {exc.strerror or exc}', file=sys.stderr)
         return 2
     t0 = time.perf_counter()
-    worlds = suite_worlds(args.count, args.seed, families)
+    worlds = suite_worlds(args.count, args.seed, families, ROBOTS[args.robot])
     for w in worlds:
         (out / f'{w.doc["name"]}.yaml').write_text(world_yaml(w.doc))
     wall = time.perf_counter() - t0
