@@ -138,6 +138,17 @@ def test_a_results_file_gives_a_row_per_method_with_its_provenance(tmp_path, mon
 
 
 @core
+def test_a_suite_kept_out_of_the_readme_is_in_the_pages_headline_only(tmp_path):
+    data, out, readme = setup_dir(tmp_path, {'tiny.json': bench_doc(RUNS)})
+    (data / 'suites.yaml').write_text(SUITES + '    readme: false\n')   # the empty one
+    assert main(args(data, out, readme)) == 0
+    block = readme.read_text().split(BEGIN)[1].split(END)[0]
+    assert 'Tiny suite' in block and 'Nothing yet' not in block
+    page_headline = out.read_text().split('## Headline')[1].split('\n## ')[0]
+    assert 'Tiny suite' in page_headline and 'Nothing yet' in page_headline
+
+
+@core
 def test_a_small_suite_gets_its_outcome_per_world(tmp_path):
     runs = [run('u_trap', 'a:geodesic', 'reached', 26.6), run('u_trap', 'b:euclidean',
                                                                'abandoned')]

@@ -85,6 +85,34 @@ def _off_walls(points):
     return np.min(np.abs(np.abs(points) - 2.0), axis=1)
 
 
+def test_a_lidar_with_less_than_a_turn_sees_its_field_of_view_only():
+    """The Jackal's LMS111: 541 beams from -135 to +135 degrees, 50 sweeps a second, each
+    taken over its 20 ms; a wall right behind the robot is not in them, one ahead is. The
+    mixed pixels do not join the first beam to the last (they are no neighbours)."""
+    doc = {'name': 'behind', 'start': [0.0, 0.0, 0.0], 'goal': [1.0, 0.0],
+           'obstacles': [{'box': {'center': [-1.5, 0.0], 'size': [0.1, 1.0]}},
+                         {'box': {'center': [2.0, 0.0], 'size': [0.1, 6.0]}}]}
+    with RobotSim(parse_world(doc), SimConfig(robot='jackal', seed=3)) as sim:
+        sim.step(0.2)
+        sweeps = sim.sweeps()
+    assert len(sweeps) == 10
+    scan = sweeps[-1]
+    assert scan.ranges.size == 541 and scan.scan_time == pytest.approx(0.02)
+    assert scan.angle_min == pytest.approx(-0.75 * math.pi)
+    assert scan.angles[-1] == pytest.approx(0.75 * math.pi)
+    points = scan_to_points(scan, (0.0, 0.0, 0.0), (0.12, 0.0, 0.0))
+    assert len(points) > 200 and points[:, 0].min() > 1.8   # nothing of the wall behind
+    ahead = np.abs(points[:, 1]) < 0.5
+    assert np.abs(points[ahead, 0] - 1.95).max() < 0.1
+    lidar = LIDARS['lms111']
+    edge = np.r_[np.full(270, 1.0), np.full(271, 5.0)]   # near on the right, far on the left
+    for seed in range(20):
+        out = corrupt(edge, dataclasses.replace(lidar, dropout=0.0, dark_runs=0.0,
+                                                mixed_pixels=1.0, bands=((20.0, 0.0, 0.0),)),
+                      np.random.default_rng(seed))
+        assert out[0] == 1.0 and out[-1] == 5.0   # not mixed across the blind sector
+
+
 def test_a_turning_robots_sweep_is_bent_and_each_beams_own_pose_unbends_it(monkeypatch):
     """Turning at 2 rad/s, the sweep's beams are taken over 0.2 s: placed at the pose
     of the sweep's first beam, the late beams miss the walls by decimetres; placed at

@@ -302,6 +302,26 @@ def test_head_on_in_a_corridor_steps_to_the_wider_side_and_keeps_to_it():
     assert again == nxt
 
 
+def test_planning_at_20_hz_and_at_5_hz_makes_the_same_escape_at_the_same_speed():
+    """The corridor's head-on walker again: planned at 5 Hz and at 20 Hz the robot takes
+    the same escape, at the same speed and turn rate, turning for the same time, and its
+    rollout over the horizon ends at the same place (each rollout step is an exact arc)."""
+    walker = Tracks(np.array([[0.9, 0.09]]), np.array([[-0.16, 0.0]]), np.array([0.25]),
+                    np.array([True]), np.array([True]), np.zeros(0, np.int64))
+    pose = np.array([0.0, -0.02, 0.0])
+    made = {}
+    for hz in (5.0, 20.0):
+        cfg = CFG.replace(planning_frequency=hz)
+        dt, _ = rollout_step(cfg.period)
+        esc = evade(pose, (0.22, 0.0), walker, corridor_walls(), cfg, False)
+        assert esc is not None
+        turning = sum(w != 0.0 for w in esc.turn) * dt
+        end = rollouts(pose, np.array([esc.v]), np.array([esc.turn]), dt)[0, -1]
+        made[hz] = (esc.v, max(esc.turn, key=abs), round(turning, 9), end)
+    assert made[5.0][:3] == made[20.0][:3]
+    np.testing.assert_allclose(made[5.0][3], made[20.0][3], atol=1e-9)
+
+
 @pytest.mark.parametrize('hz', [1.0, 5.0, 10.0, 20.0])
 def test_a_committed_escape_advances_one_planning_period_at_any_rate(hz):
     """The rollout step divides the period (and is at most 0.2 s); an escape that turns

@@ -46,19 +46,23 @@ def wrap_angle(a: float) -> float:
     return math.remainder(a, 2.0 * math.pi)
 
 
+def _robot_frame(pose: ArrayLike, points: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
+    """Points (m, 2) in the frame of the robot at ``pose``: ahead (x) and left (y) [m]."""
+    obs = np.asarray(points, float).reshape(-1, 2)
+    x, y, yaw = (float(v) for v in pose)
+    dx, dy = obs[:, 0] - x, obs[:, 1] - y
+    c, s = math.cos(yaw), math.sin(yaw)
+    return c * dx + s * dy, -s * dx + c * dy
+
+
 def forward_blocked(pose: ArrayLike, obstacles: ArrayLike, cfg: PlannerConfig) -> bool:
     """True when an obstacle point lies ahead (x > 0 in the robot frame), within the
     corridor |y| <= robot_radius and closer than safety_distance to the centre; with a
     footprint polygon, within its half-width and closer than safety_distance -
     robot_radius to its front."""
-    obs = np.asarray(obstacles, float).reshape(-1, 2)
-    if obs.shape[0] == 0:
+    fx, fy = _robot_frame(pose, obstacles)
+    if fx.size == 0:
         return False
-    x, y, yaw = (float(v) for v in pose)
-    dx, dy = obs[:, 0] - x, obs[:, 1] - y
-    c, s = math.cos(yaw), math.sin(yaw)
-    fx = c * dx + s * dy
-    fy = -s * dx + c * dy
     shape = cfg.polygon
     if shape is not None:
         reach = shape.front + cfg.safety_distance - cfg.robot_radius
@@ -75,11 +79,7 @@ def backward_blocked(pose: ArrayLike, obstacles: ArrayLike, cfg: PlannerConfig) 
     shape = cfg.polygon
     if shape is None:
         return True
-    x, y, yaw = (float(v) for v in pose)
-    obs = np.asarray(obstacles, float).reshape(-1, 2)
-    c, s = math.cos(yaw), math.sin(yaw)
-    fx = c * (obs[:, 0] - x) + s * (obs[:, 1] - y)
-    fy = -s * (obs[:, 0] - x) + c * (obs[:, 1] - y)
+    fx, fy = _robot_frame(pose, obstacles)
     rear = float(shape.vertices[:, 0].min())
     hit = (fx < 0.0) & (np.abs(fy) <= shape.half_width + TURN_MARGIN) \
         & (fx > rear - BACKING_REACH)

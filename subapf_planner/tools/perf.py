@@ -21,12 +21,14 @@ import time
 
 import numpy as np
 
-from ..core.config import METHODS, load_config
+from ..core.config import METHODS
 from ..core.occupancy import OccupancyGrid
-from ..ros.paths import default_params_file, shipped_worlds_dir
+from ..core.robot import ROBOTS
+from ..ros.paths import shipped_worlds_dir
 from ..sim.episode import run_episode
 from ..sim.simulator import SimConfig
 from ..sim.world import load_world, world_files
+from .bench import bench_config
 
 #: Bytes a field holds per block it is marched on: values, their padded copy and the
 #: downhill index for ~/plan (8 bytes each); and per map cell: passable (bool).
@@ -41,6 +43,9 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument('--field', default=None, choices=('geodesic', 'euclidean'),
                    help="attraction field (default: the params file's)")
     p.add_argument('--params', default=None, help='params YAML (default: config/planner.yaml)')
+    p.add_argument('--robot', default=None, choices=sorted(ROBOTS),
+                   help="the robot simulated and planned for, at its planning rate (as "
+                   "subapf-bench --robot; default: the params file's, else the burger)")
     p.add_argument('--repeat', type=int, default=1,
                    help='drive the worlds this many times and pool the cycles (a shared '
                    'machine is faster and slower by turns; each pass prints its median)')
@@ -50,13 +55,15 @@ def main(argv: list[str] | None = None) -> int:
     changes = {'method': args.method}
     if args.field:
         changes['attraction_field'] = args.field
-    cfg = load_config(args.params or default_params_file(), **changes)
+    robot, cfg = bench_config(args.params, args.robot)
+    cfg = cfg.replace(**changes)
     files = world_files(args.worlds or [shipped_worlds_dir()])
     t0 = time.perf_counter()
     worlds = [load_world(f) for f in files]
     runs = []
     for k in range(args.repeat):
-        runs_k = [run_episode(w, cfg, SimConfig(range_noise=0.01)) for w in worlds]
+        runs_k = [run_episode(w, cfg, SimConfig(robot=robot, range_noise=0.01))
+                  for w in worlds]
         if args.repeat > 1:
             pass_ms = np.concatenate([r.plan_ms for r in runs_k])
             print(f'pass {k + 1}: median {np.median(pass_ms):.3f} ms  '
@@ -71,6 +78,10 @@ def main(argv: list[str] | None = None) -> int:
           f'cycles={ms.size} '
           f'({time.perf_counter() - t0:.0f} s)')
     print(f'plan cycle ms: {_figures(ms)}')
+    budget = 1e3 * cfg.period
+    print(f'robot {robot} at {cfg.planning_frequency:g} Hz: a cycle has {budget:g} ms; the '
+          f'tick and the work after it, p99 {np.percentile(ms, 99):.1f} + '
+          f'{np.percentile(np.concatenate([r.after_ms for r in runs]), 99):.1f} ms')
     if recomputed.any():
         print(f'  {recomputed.sum()} cycles with a new field ({recomputed.mean():.0%}): '
               f'{_figures(ms[recomputed])}')

@@ -117,6 +117,8 @@ class Suite:
     bench: str = ''
     notes: str = ''
     runsets: list[RunSet] = field(default_factory=list)
+    #: Whether the README's headline shows it (results.md's shows every suite).
+    readme: bool = True
 
 
 def load_runset(path: Path) -> RunSet:
@@ -151,6 +153,7 @@ def load(data: Path) -> tuple[list[Suite], list[tuple[str, str]]]:
         suite = Suite(**{k: str(entry.get(k) or '').strip()
                          for k in ('name', 'title', 'worlds', 'description', 'bench',
                                    'notes')})
+        suite.readme = entry.get('readme', True) is not False
         if not suite.name or not suite.title:
             raise ValueError(f'{data / SUITES_FILE}: every suite needs a name and a title')
         files = sorted({*data.glob(f'{suite.name}.json'), *data.glob(f'{suite.name}.*.json')})
@@ -329,6 +332,8 @@ def headline(suites: list[Suite], methods: list[tuple[str, str]], docs: str | No
              '|' + '---|' * (len(methods) + 1)]
     page = f'{docs}results.md' if docs is not None else ''
     for s in suites:
+        if docs is not None and not s.readme:
+            continue   # results.md's headline only
         anchor = f'{page}#{slug(s.title)}'
         cells = ([headline_cell(s, m) for m, _ in methods] if s.runsets
                  else ['not recorded yet'] + [''] * (len(methods) - 1))
