@@ -39,6 +39,29 @@ def test_inside_the_tolerance_it_drives_on_while_it_gets_closer():
     assert 0.04 < cfg.arrival_distance and res.command.status is Status.REACHED
 
 
+def test_a_few_cycles_without_progress_do_not_end_the_approach():
+    """Turning towards a goal a few centimetres off the robot's axis brings it no closer
+    for a cycle or two: the approach goes on for ARRIVAL_PATIENCE without getting closer,
+    then ends; any progress restarts the wait."""
+    from subapf_planner.core.gates import ARRIVAL_PATIENCE
+    planner = Planner(PlannerConfig())
+    goal = (1.0, 0.0)
+
+    def at(distance, t):
+        return planner.step(np.array([1.0 - distance, 0.0, 0.0]), goal,
+                            Scan(OPEN, 0.0, 2 * math.pi / 360, 0.12, 3.5, t), now=t)
+
+    t = 0.0
+    assert at(0.12, t).command.status is not Status.REACHED
+    while t + 0.2 < ARRIVAL_PATIENCE - 1e-9:                     # no closer, 0.8 s
+        t += 0.2
+        assert at(0.12, t).command.status is not Status.REACHED
+    t += 0.2
+    assert at(0.10, t).command.status is not Status.REACHED      # 2 cm closer: on
+    t += ARRIVAL_PATIENCE
+    assert at(0.10, t).command.status is Status.REACHED          # no closer for 1 s
+
+
 def test_a_new_goal_starts_a_new_approach():
     planner = Planner(PlannerConfig())
     step(planner, (0.88, 0.0, 0.0), (1.0, 0.0), 0)

@@ -191,8 +191,9 @@ def test_deskew_puts_a_bent_sweep_back_on_the_walls(motion):
     between its first beam and its last (a constant twist): placed at the first beam's
     pose as it is, its late returns miss the walls of the square room by decimetres;
     de-skewed with the motion (core/scan.py deskew), every return is within 2.5 cm of a
-    wall (its new bin's direction is off by half a beam at most: 0.5 degrees at the
-    corners' 2.8 m), and the median within 5 mm."""
+    wall (its new beam's direction is off by half a beam at most: 0.5 degrees at the
+    corners' 2.8 m), and the median within 5 mm; keeping the bearings, every return is
+    back on its wall, in the order of its beams."""
     from subapf_planner.core.scan import Scan, deskew
     n = 360
     f = np.arange(n) / (n - 1)
@@ -205,10 +206,15 @@ def test_deskew_puts_a_bent_sweep_back_on_the_walls(motion):
     assert np.percentile(_off_walls(bent), 95) > 0.1
     straight = deskew(scan, m)
     pts = scan_to_points(straight, (0.0, 0.0, 0.0))
-    assert len(pts) > 0.9 * n
+    assert len(pts) > 0.9 * n and straight.bearings is None
     assert np.max(_off_walls(pts)) < 0.025 and np.median(_off_walls(pts)) < 0.005
     assert straight.time_increment == scan.time_increment and straight.stamp == scan.stamp
     assert deskew(scan, np.zeros(3)) is scan
+    exact = deskew(scan, m, bearings=True)
+    pts = scan_to_points(exact, (0.0, 0.0, 0.0))
+    assert len(pts) == n and np.max(_off_walls(pts)) < 1e-9
+    assert np.all(np.abs(np.diff(np.unwrap(exact.angles))) < 2 * scan.angle_increment)
+    assert deskew(exact, m, bearings=True) is exact   # de-skewed once
 
 
 @pytest.mark.core

@@ -97,7 +97,8 @@ class PlannerConfig:
     goal_tolerance: float = param(0.15, 'xy goal tolerance; stop inside it', 'm', 0.01, 5.0)
     arrival_distance: float = param(0.05, 'With the geodesic field: once inside '
                                     'goal_tolerance, drive on towards the goal until this '
-                                    'close, or until a cycle brings it no closer (so that '
+                                    'close, or until it has come no closer for a second '
+                                    '(core/gates.py ARRIVAL_PATIENCE; so that '
                                     'a pose error of a few centimetres, drift the scan '
                                     'alignment has not yet corrected, still leaves the '
                                     'robot inside the tolerance); goal_tolerance or more: '
@@ -206,6 +207,12 @@ class PlannerConfig:
     range_noise_fraction: float = param(0.025, '... and as a fraction of the range farther '
                                         'out (LDS-01: +/-5 % from 0.5 to 3.5 m, 2 sigma)',
                                         '', 0.0, 1.0)
+    deskew_bearings: bool = param(False, "De-skewed scans keep each return's exact "
+                                  'direction (core/scan.py deskew) instead of moving it to '
+                                  "the nearest beam of the scan's grid, up to half a beam "
+                                  'off: the scan alignment follows real buildings better, '
+                                  'the tracker sees more ghosts in clutter '
+                                  '(docs/alignment.md)')
     # --- moving obstacles (core/tracking.py, core/evasion.py) ------------------------
     track_moving: bool = param(True, 'Track moving obstacles from the scans (clusters, '
                                'constant-velocity Kalman filters): their points stay out of '

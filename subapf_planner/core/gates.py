@@ -28,12 +28,12 @@ from .status import Status
 #: (the occupancy grid's walls are established by three hits), for this many cycles at
 #: most (a scan repeated with the same stamp is not taken twice).
 FIRST_SCANS = 3
-#: Inside goal_tolerance, a cycle that brings the robot less than this closer to the goal
-#: ends the approach (it cannot get closer: arrival_distance) [m] for a 0.2 s period, in
-#: proportion for another; a tenth of the distance the burger drives in one 0.2 s period
-#: at its slowest approach speed.
+#: Inside goal_tolerance the approach goes on while the robot gets this much closer to the
+#: goal than it has been [m] at least once every ARRIVAL_PATIENCE [s]: a cycle or two
+#: spent turning towards the goal (a few centimetres off its axis the heading to it is
+#: steep) does not end it, a robot that cannot get closer stops (arrival_distance).
 ARRIVAL_PROGRESS = 0.002
-ARRIVAL_PERIOD = 0.2
+ARRIVAL_PATIENCE = 1.0
 
 
 def input_status(pose: ArrayLike, goal: ArrayLike) -> Status | None:
@@ -63,14 +63,15 @@ def goal_status(cfg: PlannerConfig, goal_distance: float, goal: NDArray[np.float
 class Goal(Stage):
     """``reached`` or ``goal_in_obstacle`` (:func:`goal_status`). With the memory, the
     approach goes on inside goal_tolerance while the robot is farther than
-    ``arrival_distance`` and each cycle brings it at least ARRIVAL_PROGRESS closer (per
-ARRIVAL_PERIOD of planning period; a
-    pose error of a few centimetres still leaves it inside the tolerance)."""
+    ``arrival_distance`` and gets ARRIVAL_PROGRESS closer than it has been at least once
+    every ARRIVAL_PATIENCE (a pose error of a few centimetres still leaves it inside the
+    tolerance)."""
 
     name = 'goal'
 
     def __init__(self) -> None:
-        self._approach: tuple[NDArray, float] | None = None   # last cycle's goal, distance
+        #: Inside the tolerance: the goal, the least distance to it so far and when [s].
+        self._approach: tuple[NDArray, float, float] | None = None
 
     def forget(self) -> None:
         self._approach = None
@@ -79,7 +80,8 @@ ARRIVAL_PERIOD of planning period; a
         status = goal_status(cycle.cfg, cycle.goal_distance, cycle.goal, cycle.obstacles)
         if status is Status.REACHED and self.drives_on(cycle):
             status = None
-        self._approach = (cycle.goal, cycle.goal_distance)
+        if cycle.goal_distance > cycle.cfg.goal_tolerance:
+            self._approach = None
         return cycle.with_(status=status)
 
     def drives_on(self, cycle: Cycle) -> bool:
@@ -87,11 +89,11 @@ ARRIVAL_PERIOD of planning period; a
         cfg, distance = cycle.cfg, cycle.goal_distance
         if not cfg.geodesic or distance <= cfg.arrival_distance:
             return False
-        if self._approach is None or not np.array_equal(self._approach[0], cycle.goal):
+        if self._approach is None or not np.array_equal(self._approach[0], cycle.goal) \
+                or distance <= self._approach[1] - ARRIVAL_PROGRESS:
+            self._approach = (cycle.goal, distance, cycle.now)   # closer than ever: on
             return True
-        before = self._approach[1]
-        return before > cfg.goal_tolerance \
-            or before - distance >= ARRIVAL_PROGRESS * (cfg.period / ARRIVAL_PERIOD)
+        return cycle.now - self._approach[2] < ARRIVAL_PATIENCE
 
 
 class Mapping(Stage):

@@ -316,7 +316,8 @@ class DecisionLoop:
         (GRAZING_MEMORY); once per scan."""
         if self._deskew is None or self._deskew[0] is not scan:
             cfg = self.cfg
-            straight = deskew(scan, self.sweep_motion(scan), cfg.laser_mount)
+            straight = deskew(scan, self.sweep_motion(scan), cfg.laser_mount,
+                              cfg.deskew_bearings)
             self._deskew = (scan, *denoise_each(straight, cfg.range_noise_floor,
                                                 cfg.range_noise_fraction,
                                                 (GRAZING_OBSTACLES, GRAZING_MEMORY)))

@@ -36,7 +36,10 @@ class Scan:
     angle_increment`` [rad], valid returns in [range_min, range_max) [m], ``stamp``:
     capture time of beam 0 [s] (NaN: unknown, every use of it is new); beam i taken
     ``i * time_increment`` [s] after it (0: all at once), a sweep every ``scan_time``
-    [s] (0: unknown), as sensor_msgs/LaserScan has them.
+    [s] (0: unknown), as sensor_msgs/LaserScan has them. ``bearings`` (one per beam
+    [rad], in the laser's frame; None: the beams' own angles): where each return lies
+    once the sweep is de-skewed (:func:`deskew`), which no grid of angles can hold
+    exactly.
     """
 
     ranges: NDArray[np.float64]
@@ -47,6 +50,7 @@ class Scan:
     stamp: float = math.nan
     time_increment: float = 0.0
     scan_time: float = 0.0
+    bearings: NDArray[np.float64] | None = None
 
     def check(self) -> None:
         """Raise ScanError for a non-finite geometry or an angle_increment <= 0 with more
@@ -56,6 +60,9 @@ class Scan:
             raise ScanError(f'non-finite scan geometry {geometry}')
         if np.size(self.ranges) > 1 and self.angle_increment <= 0.0:
             raise ScanError(f'angle_increment must be positive, got {self.angle_increment}')
+        if self.bearings is not None and np.size(self.bearings) != np.size(self.ranges):
+            raise ScanError(f'{np.size(self.bearings)} bearings for {np.size(self.ranges)} '
+                            'beams')
 
     @property
     def beam_interval(self) -> float:
@@ -69,7 +76,10 @@ class Scan:
 
     @property
     def angles(self) -> NDArray[np.float64]:
-        """Angle of each beam in the laser frame [rad]."""
+        """Angle of each beam (of its return, for a de-skewed scan) in the laser frame
+        [rad]."""
+        if self.bearings is not None:
+            return self.bearings
         return beam_angles(np.size(self.ranges), self.angle_min, self.angle_increment)
 
     def valid(self, max_range: float = math.inf) -> NDArray[np.bool_]:
@@ -112,15 +122,19 @@ def scan_to_points(scan: Scan, pose: ArrayLike, mount: ArrayLike = (0.0, 0.0, 0.
     return to_parent(pose, to_parent(mount, in_laser))
 
 
-def deskew(scan: Scan, motion: ArrayLike, mount: ArrayLike = (0.0, 0.0, 0.0)) -> Scan:
+def deskew(scan: Scan, motion: ArrayLike, mount: ArrayLike = (0.0, 0.0, 0.0),
+           bearings: bool = False) -> Scan:
     """The scan as if every beam had been taken at its first beam's instant: ``motion``
     (x, y, yaw) is base_footprint's motion from the first beam to the last, in its pose
     at the first (from odometry); beam i, taken ``i * time_increment`` after the first,
     is placed with the fraction i / (n - 1) of it (a constant twist over the sweep),
-    ``mount`` the laser in base_footprint. The returns keep their bins: each lands in
-    the bin of its direction from the laser at the first beam (the nearest return when
-    several land in one; a bin none lands in has no return, NaN: it clears no cell).
-    A scan taken all at once (time_increment 0), or with no motion, is returned as it
+    ``mount`` the laser in base_footprint. Each return's direction and range from the
+    laser at the first beam are then kept as they are (``bearings``: Scan.bearings, in
+    the order of the beams), or the return lands in the beam of the scan's grid of
+    angles nearest its direction (the nearest return when several land in one; a beam
+    none lands in has no return, NaN: it clears no cell), up to half a beam off, by an
+    amount that changes slowly along the sweep (docs/alignment.md). A scan taken all at
+    once (time_increment 0), or with no motion, or de-skewed already, is returned as it
     is. Beams with no return keep it. The beams keep their instants (time_increment):
     what moved during the sweep is where it was when its beam saw it (the tracker
     dates its clusters by them); so a scan is de-skewed once (DecisionLoop._deskewed)."""
@@ -128,13 +142,13 @@ def deskew(scan: Scan, motion: ArrayLike, mount: ArrayLike = (0.0, 0.0, 0.0)) ->
     motion = np.array(motion, float).ravel()
     if motion.size == 3 and math.isfinite(motion[2]):   # a sweep turns less than a turn
         motion[2] = math.remainder(motion[2], 2 * math.pi)
-    if n < 2 or scan.beam_interval <= 0.0 or not np.all(np.isfinite(motion)) \
-            or not np.any(motion):
+    if n < 2 or scan.beam_interval <= 0.0 or scan.bearings is not None \
+            or not np.all(np.isfinite(motion)) or not np.any(motion):
         return scan
     scan.check()
     r = np.asarray(scan.ranges, float).ravel()
     hit = scan.valid()
-    f = np.arange(n)[hit] / (n - 1)
+    f = np.arange(n) / (n - 1)
     mx, my, myaw = (float(v) for v in mount)
     # the laser at beam i in the laser's frame at the first beam: mount^-1 . m_i . mount,
     # m_i = f_i * motion (base_footprint's motion so far)
@@ -143,8 +157,16 @@ def deskew(scan: Scan, motion: ArrayLike, mount: ArrayLike = (0.0, 0.0, 0.0)) ->
     py = f * motion[1] + np.sin(th) * mx + np.cos(th) * my - my
     c0, s0 = math.cos(myaw), math.sin(myaw)
     lx, ly = c0 * px + s0 * py, -s0 * px + c0 * py
-    a = scan.angles[hit] + th   # (the laser's yaw moved by as much as the base's)
-    ex, ey = lx + r[hit] * np.cos(a), ly + r[hit] * np.sin(a)
+    a = scan.angles + th   # (the laser's yaw moved by as much as the base's)
+    ex = lx[hit] + r[hit] * np.cos(a[hit])
+    ey = ly[hit] + r[hit] * np.sin(a[hit])
+    geometry = (scan.angle_min, scan.angle_increment, scan.range_min, scan.range_max,
+                scan.stamp, scan.time_increment, scan.scan_time)
+    if bearings:
+        ranges, directions = r.copy(), a
+        ranges[hit] = np.hypot(ex, ey)
+        directions[hit] = np.arctan2(ey, ex)
+        return Scan(ranges, *geometry, directions)
     inc = scan.angle_increment
     bins = np.rint(np.mod(np.arctan2(ey, ex) - scan.angle_min, 2.0 * math.pi) / inc
                    ).astype(np.int64)
@@ -156,8 +178,7 @@ def deskew(scan: Scan, motion: ArrayLike, mount: ArrayLike = (0.0, 0.0, 0.0)) ->
     out = np.where(hit, np.nan, r)   # returns re-binned below; no-return beams kept
     order = np.argsort(-dist)   # nearest written last: it wins its bin
     out[bins[order]] = dist[order]
-    return Scan(out, scan.angle_min, scan.angle_increment, scan.range_min, scan.range_max,
-                scan.stamp, scan.time_increment, scan.scan_time)
+    return Scan(out, *geometry)
 
 
 def range_sigma(ranges: ArrayLike, floor: float, fraction: float) -> NDArray[np.float64]:
@@ -242,7 +263,7 @@ def denoise_each(scan: Scan, floor: float, fraction: float, grazing: Sequence[fl
     ok = hit & (count >= 3.0) & np.isfinite(on_line) & (np.abs(on_line - rr) <= 4.0 * sigma)
     return tuple(Scan(np.where(ok & (np.abs(meet) >= bound), on_line, r), scan.angle_min,
                       scan.angle_increment, scan.range_min, scan.range_max, scan.stamp,
-                      scan.time_increment, scan.scan_time) for bound in grazing)
+                      scan.time_increment, scan.scan_time, scan.bearings) for bound in grazing)
 
 
 def geometry_warning(n: int, angle_min: float, angle_max: float,
