@@ -102,7 +102,8 @@ def test_a_gap_it_cannot_pass_is_tried_for_seconds_then_the_other_way_taken():
     result = run_episode(narrow_gap_world(0.25), EXACT_CFG.replace(field_worker=False), EXACT,
                          limits=Supervision(recoveries=1))
     assert result.outcome is Outcome.REACHED
-    assert 0 < result.statuses.get('no_safe_move', 0) <= 5 * 4   # 5 Hz: at most ~4 s
+    # 5 Hz: blocked_timeout and a second of standing before it, far below progress_timeout
+    assert 0 < result.statuses.get('no_safe_move', 0) <= 5 * 5
     assert result.path[:, 0].max() > 5.5                          # round the wall's end
 
 

@@ -197,6 +197,10 @@ class PlannerConfig:
                                  'and the memory, the field and the goal live in the '
                                  'corrected frame (with the geodesic attraction; '
                                  'docs/alignment.md). Switching it starts an empty map')
+    odometry_calibration: bool = param(True, "Learn odometry's distance and turn scales "
+                                       'from scan-to-scan registration and predict the '
+                                       "scan alignment's pose with them "
+                                       '(core/odometry_calibration.py; with scan_alignment)')
     range_noise_floor: float = param(0.0075, "The lidar's range noise (standard deviation) "
                                      'near it: each scan is averaged along its surfaces '
                                      'by it (core/scan.py denoise), the scan alignment '

@@ -43,6 +43,7 @@ from .gates import goal_status, input_status
 from .known_map import KnownMap
 from .memory import SAME_GOAL, NavigationMemory
 from .navigation import NavigationField
+from .odometry_calibration import OdometryCalibration, scaled
 from .pipeline import Pipeline
 from .proposers import local_radius
 from .robot import compose, invert, to_parent
@@ -53,6 +54,10 @@ from .tracking import NO_TRACKS, STANDING_SCANS, Tracker, Tracks
 
 __all__ = ['Perception', 'PlanResult', 'Planner', 'goal_status', 'input_status',
            'local_radius', 'plan']
+
+#: Returns this close to something that moves [m] take no part in the odometry's
+#: calibration.
+MOVER_MARGIN = 0.1
 
 
 @dataclass(frozen=True)
@@ -113,6 +118,14 @@ def _tracker_settings(cfg: PlannerConfig) -> tuple[float, float, float, float]:
 
 def _tracker(cfg: PlannerConfig) -> Tracker:
     return Tracker(*_tracker_settings(cfg))
+
+
+def _near(points: NDArray, centres: NDArray, radii: NDArray) -> NDArray[np.bool_]:
+    """Which ``points`` (n, 2) lie within MOVER_MARGIN of one of the discs (k, 2; k,)."""
+    if not len(radii) or not len(points):
+        return np.zeros(len(points), bool)
+    d = np.hypot(*(points[:, None, :] - centres[None, :, :]).transpose(2, 0, 1))
+    return np.any(d <= radii + MOVER_MARGIN, axis=1)
 
 
 class Planner:
@@ -179,6 +192,8 @@ class Planner:
         self._aligned_from: NDArray | None = None   # odom pose of the last scan matched
         self._goal: tuple[NDArray, NDArray] | None = None   # (in odom, in the memory's frame)
         self._planned_from: NDArray | None = None   # the last cycle's pose (memory's frame)
+        #: Odometry's distance and turn scales, learnt (with odometry_calibration).
+        self.odometry = OdometryCalibration()
 
     @property
     def planned_from(self) -> NDArray[np.float64] | None:
@@ -292,16 +307,24 @@ class Planner:
         if scan.stamp == self._aligned_stamp:
             return
         self._aligned_stamp = scan.stamp
-        predicted = self.in_map(scan_pose)
-        self.match = self.memory.align(base, predicted, self._moving_discs(scan.stamp))
+        discs = self._moving_discs(scan.stamp)
         last, self._aligned_from = self._aligned_from, scan_pose
-        if last is None or not self.match.accepted:
-            return
-        moved = compose(invert(last), scan_pose)   # odometry's motion since the last scan
-        pose = within_drift(predicted, self.match.pose, math.hypot(moved[0], moved[1]),
-                            moved[2])
-        if not np.array_equal(pose, predicted):
-            self.correction = compose(pose, invert(scan_pose))
+        predicted = self.in_map(scan_pose)
+        if self.cfg.odometry_calibration:
+            if last is not None:   # odometry's motion since the last scan, calibrated
+                moved = scaled(compose(invert(last), scan_pose), self.odometry.scales)
+                predicted = np.array(compose(self.in_map(last), moved))
+            self.odometry.observe(base[~_near(to_parent(predicted, base), *discs)], scan_pose)
+            predicted = self.odometry.correct(predicted)   # the scans' own registration
+        self.match = self.memory.align(base, predicted, discs)
+        pose = predicted
+        if last is not None and self.match.accepted:
+            moved = compose(invert(last), scan_pose)   # odometry's motion since the last scan
+            pose = within_drift(predicted, self.match.pose, math.hypot(moved[0], moved[1]),
+                                moved[2])
+        if not np.array_equal(pose, self.in_map(scan_pose)):
+            self.correction = tuple(float(v) for v in compose(pose, invert(scan_pose)))
+        self.odometry.place(pose)
 
     def _moving_discs(self, t: float) -> tuple[NDArray, NDArray]:
         """Where the last scan's tracks that move, are held out of the memory or seem to
