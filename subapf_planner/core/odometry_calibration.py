@@ -218,6 +218,8 @@ class OdometryCalibration:
         motion = np.array(compose(invert(key_odom), odom))
         distance, turn = math.hypot(motion[0], motion[1]), abs(motion[2])
         if distance < KEY_DISTANCE and turn < KEY_TURN:
+            if len(key_points) < MIN_MATCHED <= len(points):   # a keyframe with too little
+                self._key, self._placing = (np.asarray(points, float), odom), True
             return
         self._key, self._placing = (np.asarray(points, float), odom), True
         found = register(key_points, np.asarray(points, float), motion)

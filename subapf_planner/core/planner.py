@@ -43,6 +43,7 @@ from .gates import goal_status, input_status
 from .known_map import KnownMap
 from .memory import SAME_GOAL, NavigationMemory
 from .navigation import NavigationField
+from .occupancy import ESTABLISHED
 from .odometry_calibration import OdometryCalibration, scaled
 from .pipeline import Pipeline
 from .proposers import local_radius
@@ -314,7 +315,9 @@ class Planner:
             if last is not None:   # odometry's motion since the last scan, calibrated
                 moved = scaled(compose(invert(last), scan_pose), self.odometry.scales)
                 predicted = np.array(compose(self.in_map(last), moved))
-            self.odometry.observe(base[~_near(to_parent(predicted, base), *discs)], scan_pose)
+            placed = to_parent(predicted, base)   # what walks left out, walls kept
+            self.odometry.observe(base[~_near(placed, *discs) & self._on_walls(placed)],
+                                  scan_pose)
             predicted = self.odometry.correct(predicted)   # the scans' own registration
         self.match = self.memory.align(base, predicted, discs)
         pose = predicted
@@ -325,6 +328,20 @@ class Planner:
         if not np.array_equal(pose, self.in_map(scan_pose)):
             self.correction = tuple(float(v) for v in compose(pose, invert(scan_pose)))
         self.odometry.place(pose)
+
+    def _on_walls(self, points: NDArray) -> NDArray[np.bool_]:
+        """Which ``points`` (n, 2) [m] in the memory's frame lie on or beside (one cell)
+        a cell the memory is sure of (established): not what walks through it."""
+        grid = self.memory.grid
+        wall = grid.log_odds >= ESTABLISHED
+        cells = grid.cell_of(points)
+        found = np.zeros(len(points), bool)
+        for step in ((0, 0), (0, 1), (0, -1), (1, 0), (-1, 0), (1, 1), (1, -1), (-1, 1),
+                     (-1, -1)):
+            c = cells + step
+            ok = grid.inside(c)
+            found[ok] |= wall[c[ok, 0], c[ok, 1]]
+        return found
 
     def _moving_discs(self, t: float) -> tuple[NDArray, NDArray]:
         """Where the last scan's tracks that move, are held out of the memory or seem to
