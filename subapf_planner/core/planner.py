@@ -318,7 +318,10 @@ class Planner:
             placed = to_parent(predicted, base)   # what walks left out, walls kept
             self.odometry.observe(base[~_near(placed, *discs) & self._on_walls(placed)],
                                   scan_pose)
-            predicted = self.odometry.correct(predicted)   # the scans' own registration
+            if last is not None:   # the scans' own registration, no faster than drift
+                moved = compose(invert(last), scan_pose)
+                predicted = within_drift(predicted, self.odometry.correct(predicted),
+                                         math.hypot(moved[0], moved[1]), moved[2])
         self.match = self.memory.align(base, predicted, discs)
         pose = predicted
         if last is not None and self.match.accepted:
