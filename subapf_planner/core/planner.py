@@ -311,23 +311,24 @@ class Planner:
         discs = self._moving_discs(scan.stamp)
         last, self._aligned_from = self._aligned_from, scan_pose
         predicted = self.in_map(scan_pose)
+        moved = None if last is None else compose(invert(last), scan_pose)
+        # odometry's motion since the last scan: the most the pose may be corrected by
+        distance, turn = (0.0, 0.0) if moved is None else (math.hypot(moved[0], moved[1]),
+                                                            moved[2])
         if self.cfg.odometry_calibration:
-            if last is not None:   # odometry's motion since the last scan, calibrated
-                moved = scaled(compose(invert(last), scan_pose), self.odometry.scales)
-                predicted = np.array(compose(self.in_map(last), moved))
+            if moved is not None:   # the motion as calibrated
+                predicted = np.array(compose(self.in_map(last),
+                                             scaled(moved, self.odometry.scales)))
             placed = to_parent(predicted, base)   # what walks left out, walls kept
             self.odometry.observe(base[~_near(placed, *discs) & self._on_walls(placed)],
                                   scan_pose)
-            if last is not None:   # the scans' own registration, no faster than drift
-                moved = compose(invert(last), scan_pose)
+            if moved is not None:   # the scans' own registration, no faster than drift
                 predicted = within_drift(predicted, self.odometry.correct(predicted),
-                                         math.hypot(moved[0], moved[1]), moved[2])
+                                         distance, turn)
         self.match = self.memory.align(base, predicted, discs)
         pose = predicted
-        if last is not None and self.match.accepted:
-            moved = compose(invert(last), scan_pose)   # odometry's motion since the last scan
-            pose = within_drift(predicted, self.match.pose, math.hypot(moved[0], moved[1]),
-                                moved[2])
+        if moved is not None and self.match.accepted:
+            pose = within_drift(predicted, self.match.pose, distance, turn)
         if not np.array_equal(pose, self.in_map(scan_pose)):
             self.correction = tuple(float(v) for v in compose(pose, invert(scan_pose)))
         self.odometry.place(pose)
@@ -336,14 +337,13 @@ class Planner:
         """Which ``points`` (n, 2) [m] in the memory's frame lie on or beside (one cell)
         a cell the memory is sure of (established): not what walks through it."""
         grid = self.memory.grid
-        wall = grid.log_odds >= ESTABLISHED
         cells = grid.cell_of(points)
         found = np.zeros(len(points), bool)
         for step in ((0, 0), (0, 1), (0, -1), (1, 0), (-1, 0), (1, 1), (1, -1), (-1, 1),
                      (-1, -1)):
             c = cells + step
             ok = grid.inside(c)
-            found[ok] |= wall[c[ok, 0], c[ok, 1]]
+            found[ok] |= grid.log_odds[c[ok, 0], c[ok, 1]] >= ESTABLISHED
         return found
 
     def _moving_discs(self, t: float) -> tuple[NDArray, NDArray]:
