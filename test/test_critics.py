@@ -65,12 +65,17 @@ def test_only_progress_ignores_the_priority():
 
 
 @pytest.mark.parametrize('changes, gates, proposer, filters', [
-    ({}, ('goal', 'mapping', 'reachability'), 'apf_sampling', ('evasion',)),
-    ({'scan_alignment': False}, ('goal', 'reachability'), 'apf_sampling', ('evasion',)),
-    ({'track_moving': False}, ('goal', 'mapping', 'reachability'), 'apf_sampling', ()),
+    ({}, ('goal', 'mapping', 'reachability'), 'apf_sampling',
+     ('final_approach', 'evasion')),
+    ({'scan_alignment': False}, ('goal', 'reachability'), 'apf_sampling',
+     ('final_approach', 'evasion')),
+    ({'track_moving': False}, ('goal', 'mapping', 'reachability'), 'apf_sampling',
+     ('final_approach',)),
+    ({'final_approach': False}, ('goal', 'mapping', 'reachability'), 'apf_sampling',
+     ('evasion',)),
     ({'attraction_field': 'euclidean'}, ('goal',), 'apf_sampling', ()),
     ({'attraction_field': 'euclidean', 'method': 'harmonic'}, ('goal',), 'apf', ()),
-    ({'method': 'dwa'}, ('goal', 'mapping', 'reachability'), 'dwa', ()),
+    ({'method': 'dwa'}, ('goal', 'mapping', 'reachability'), 'dwa', ('final_approach',)),
 ])
 def test_the_parameters_choose_the_stages(changes, gates, proposer, filters):
     names = stage_names(PlannerConfig(**changes))

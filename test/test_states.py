@@ -72,12 +72,12 @@ def test_reached_stays_until_the_next_goal():
     """A final state is final: reached stays (no command) until a goal comes, and the
     same goal again is a new attempt."""
     loop = DecisionLoop(PlannerConfig())
-    loop.set_goal(np.array([0.05, 0.0]))
+    loop.set_goal(np.array([0.005, 0.0]))
     first, *after = run(loop, 0.0, 4)
     assert first.state is State.REACHED and first.command == (0.0, 0.0)
     assert all(d.state is State.REACHED and d.command is None and d.text == first.text
                for d in after)
-    assert loop.set_goal(np.array([0.05, 0.0]))
+    assert loop.set_goal(np.array([0.005, 0.0]))
     assert loop.state is State.DRIVING and loop.reason == 'new goal'
     assert run(loop, 1.0, 1)[0].state is State.REACHED
     assert loop.set_goal(np.array([2.0, 0.0]))

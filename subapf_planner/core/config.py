@@ -95,14 +95,19 @@ class PlannerConfig:
     rotate_in_place_angle: float = param(0.9, 'Turn on the spot when the heading error '
                                           'exceeds this', 'rad', 0.0, math.pi)
     goal_tolerance: float = param(0.15, 'xy goal tolerance; stop inside it', 'm', 0.01, 5.0)
-    arrival_distance: float = param(0.05, 'With the geodesic field: once inside '
+    arrival_distance: float = param(0.01, 'With the geodesic field: once inside '
                                     'goal_tolerance, drive on towards the goal until this '
                                     'close, or until it has come no closer for a second '
                                     '(core/gates.py ARRIVAL_PATIENCE; so that '
                                     'a pose error of a few centimetres, drift the scan '
                                     'alignment has not yet corrected, still leaves the '
-                                    'robot inside the tolerance); goal_tolerance or more: '
+                                    'robot inside the tolerance; final_approach heads '
+                                    'for the goal there); goal_tolerance or more: '
                                     'stop on entering it', 'm', 0.0, 5.0)
+    final_approach: bool = param(True, 'With the geodesic field: inside goal_tolerance, '
+                                 'head for the goal itself instead of the sampled step '
+                                 '(core/approach.py), so that the robot stops where it '
+                                 'thinks the goal is, not centimetres short of it')
     slowdown_distance: float = param(0.4, 'Speed scales down linearly inside this distance '
                                       'of the goal', 'm', 0.0, 10.0)
     approach_speed: float = param(0.055, 'Least speed the slow-down near the goal comes to '

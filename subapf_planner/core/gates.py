@@ -31,7 +31,8 @@ FIRST_SCANS = 3
 #: Inside goal_tolerance the approach goes on while the robot gets this much closer to the
 #: goal than it has been [m] at least once every ARRIVAL_PATIENCE [s]: a cycle or two
 #: spent turning towards the goal (a few centimetres off its axis the heading to it is
-#: steep) does not end it, a robot that cannot get closer stops (arrival_distance).
+#: steep) does not end it, a robot that cannot get closer stops (arrival_distance). The
+#: time the robot needs to turn to face the goal at its top turn rate is added.
 ARRIVAL_PROGRESS = 0.002
 ARRIVAL_PATIENCE = 1.0
 
@@ -64,8 +65,8 @@ class Goal(Stage):
     """``reached`` or ``goal_in_obstacle`` (:func:`goal_status`). With the memory, the
     approach goes on inside goal_tolerance while the robot is farther than
     ``arrival_distance`` and gets ARRIVAL_PROGRESS closer than it has been at least once
-    every ARRIVAL_PATIENCE (a pose error of a few centimetres still leaves it inside the
-    tolerance)."""
+    every ARRIVAL_PATIENCE, plus the time to turn to face the goal (a pose error of a
+    few centimetres still leaves it inside the tolerance)."""
 
     name = 'goal'
 
@@ -93,7 +94,12 @@ class Goal(Stage):
                 or distance <= self._approach[1] - ARRIVAL_PROGRESS:
             self._approach = (cycle.goal, distance, cycle.now)   # closer than ever: on
             return True
-        return cycle.now - self._approach[2] < ARRIVAL_PATIENCE
+        # a goal the robot must first turn to (behind it, after passing it) adds that turn
+        x, y, yaw = cycle.pose
+        turn = abs(math.remainder(math.atan2(cycle.goal[1] - y, cycle.goal[0] - x) - yaw,
+                                  2.0 * math.pi))
+        return cycle.now - self._approach[2] < ARRIVAL_PATIENCE + turn / max(
+            cfg.max_angular_velocity, 1e-9)
 
 
 class Mapping(Stage):

@@ -1,7 +1,8 @@
 """Which stages a cycle runs, from the parameters, and the registry of stages.
 
 A stage is registered here by name, in one of three kinds (core/cycle.py): gates
-(core/gates.py), proposers (core/proposers.py), filters (core/filters.py). The
+(core/gates.py), proposers (core/proposers.py), filters (core/approach.py,
+core/filters.py). The
 parameters choose them (:func:`stage_names`); the sampling's scoring terms are chosen
 by ``critics`` (core/critics/). A new stage is one module and a line here.
 """
@@ -11,6 +12,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from dataclasses import dataclass
 
+from .approach import FinalApproach
 from .config import PlannerConfig
 from .cycle import Stage
 from .filters import Evasion
@@ -26,6 +28,7 @@ STAGES: dict[str, Callable[[NavigationMemory], Stage]] = {
     'apf_sampling': lambda memory: ApfSampling(),
     'apf': lambda memory: Apf(),
     'dwa': lambda memory: Dwa(),
+    'final_approach': lambda memory: FinalApproach(),
     'evasion': lambda memory: Evasion(),
 }
 
@@ -46,15 +49,18 @@ class StageNames:
 def stage_names(cfg: PlannerConfig) -> StageNames:
     """The stages ``cfg`` asks for: the goal gate; with the memory (``attraction_field:
     geodesic``) the mapping stand (with ``scan_alignment``) and the reachability gate;
-    the proposer of ``method``; the evasion filter with the tracker (not for DWA, which
-    does without)."""
+    the proposer of ``method``; with the memory and ``final_approach`` the final
+    approach filter (core/approach.py); the evasion filter with the tracker (not for
+    DWA, which does without)."""
     gates = ['goal']
     if cfg.geodesic and cfg.scan_alignment:
         gates.append('mapping')
     if cfg.geodesic:
         gates.append('reachability')
     proposer = {'subharmonic_sampling': 'apf_sampling', 'dwa': 'dwa'}.get(cfg.method, 'apf')
-    filters = ('evasion',) if cfg.tracks_moving and cfg.method != 'dwa' else ()
+    filters = ('final_approach',) if cfg.geodesic and cfg.final_approach else ()
+    if cfg.tracks_moving and cfg.method != 'dwa':
+        filters += ('evasion',)
     return StageNames(tuple(gates), proposer, filters)
 
 
