@@ -32,8 +32,10 @@ def test_a_beam_marks_its_end_and_clears_what_it_crossed():
     occ = grid.occupied()
     end = tuple(grid.cell_of([2.0, 0.0])[0])
     assert occ[end] and grid.log_odds[end] > 1.0
-    for x in np.arange(0.05, 1.9, 0.05):      # crossed cells lost evidence
+    for x in np.arange(0.15, 1.9, 0.05):      # crossed cells lost evidence
         assert grid.log_odds[tuple(grid.cell_of([x, 0.0])[0])] < 1.0, x
+    # closer than range_min (0.12 m) the lidar says nothing: kept (core/blind_spots.py)
+    assert grid.log_odds[tuple(grid.cell_of([0.05, 0.0])[0])] == 1.0
     assert grid.log_odds[tuple(grid.cell_of([2.5, 0.0])[0])] == 1.0   # beyond: untouched
     assert grid.log_odds[tuple(grid.cell_of([0.0, 1.0])[0])] == 1.0   # off the beam
 
@@ -51,6 +53,7 @@ def test_open_beam_clears_up_to_its_range():
     grid.update(Scan([math.inf], 0.0, 0.01, 0.12, 3.5), (0.0, 0.0, 0.0), clear_range=2.0)
     assert grid.log_odds[tuple(grid.cell_of([1.9, 0.0])[0])] < 0.5
     assert grid.log_odds[tuple(grid.cell_of([2.2, 0.0])[0])] == 0.5
+    assert grid.log_odds[tuple(grid.cell_of([0.05, 0.0])[0])] == 0.5   # within range_min
 
 
 def test_an_obstacle_seen_then_seen_through_is_forgotten():

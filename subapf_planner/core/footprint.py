@@ -103,6 +103,18 @@ class Footprint:
         out = fx[..., None] * normals[:, 0] + fy[..., None] * normals[:, 1] - offsets
         return np.any(near & np.all(out <= margin, axis=-1), axis=1)
 
+    def covers(self, pose: ArrayLike, points: ArrayLike) -> NDArray[np.bool_]:
+        """Per point (m, 2), whether it lies inside the footprint placed at ``pose``
+        (x, y, yaw)."""
+        x, y, yaw = (float(v) for v in np.asarray(pose, float).ravel()[:3])
+        pts = np.asarray(points, float).reshape(-1, 2)
+        c, s = math.cos(yaw), math.sin(yaw)
+        dx, dy = pts[:, 0] - x, pts[:, 1] - y
+        fx, fy = c * dx + s * dy, -s * dx + c * dy
+        normals, offsets = self._normals
+        out = fx[:, None] * normals[:, 0] + fy[:, None] * normals[:, 1] - offsets
+        return np.all(out <= 0.0, axis=1)
+
     def turn_contact(self, pose: ArrayLike, turn: float, points: ArrayLike,
                      margin: float) -> bool:
         """Whether turning on the spot from ``pose`` by ``turn`` [rad] brings a point

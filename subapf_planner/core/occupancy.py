@@ -8,9 +8,11 @@ This grid is what the navigation field (core/navigation.py) is computed on.
 Update rule, per beam of a scan taken at the laser's odom pose:
 
 * a valid return (finite, in [range_min, range_max)) adds ``hit`` to the log
-  odds of its end cell and ``miss`` to every cell the beam crossed before it;
-* a ``+inf`` return (no echo within range) adds ``miss`` along the whole beam up
-  to ``clear_range`` (at most range_max): open space is forgotten obstacles;
+  odds of its end cell and ``miss`` to every cell the beam crossed before it,
+  from range_min on (a lidar says nothing about what is closer to it);
+* a ``+inf`` return (no echo within range) adds ``miss`` along the whole beam
+  from range_min up to ``clear_range`` (at most range_max): open space is
+  forgotten obstacles;
 * NaN, 0.0, negative and below-range_min returns are not evidence of anything
   (LDS-01 and LDS-02 invalid beams) and change nothing.
 
@@ -227,12 +229,16 @@ class OccupancyGrid:
         a, length, ends_hit = angles[use], lengths[use], hit[use]
         marked = ends_hit if transient is None else ends_hit & ~transient[use]
         res = self.resolution
-        # free samples at (k + 1/2) cells along each beam, stopping half a cell before a
-        # return so its own cell is not cleared; built ragged (only the samples a beam has)
+        # free samples at (k + 1/2) cells along each beam, from range_min (the lidar says
+        # nothing about what is closer: core/blind_spots.py), stopping half a cell before
+        # a return so its own cell is not cleared; built ragged (only the samples a beam
+        # has)
         stop = np.where(ends_hit, length - 0.5 * res, length)
-        counts = np.maximum(np.ceil(stop / res - 0.5), 0).astype(np.int64)
+        first = max(math.ceil(scan.range_min / res - 0.5), 0)
+        counts = np.maximum(np.ceil(stop / res - 0.5) - first, 0).astype(np.int64)
         beam = np.repeat(np.arange(a.size), counts)
-        k = np.arange(beam.size) - np.repeat(np.cumsum(counts) - counts, counts) + 0.5
+        k = np.arange(beam.size) - np.repeat(np.cumsum(counts) - counts, counts) + 0.5 \
+            + first
         # cells in a box around the laser that holds every beam (not the whole window)
         n = self.cells
         reach_cells = int(math.ceil(float(length.max()) / res)) + 1

@@ -36,6 +36,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from .alignment import Match, within_drift
+from .blind_spots import blind_obstacles
 from .command import Command
 from .config import PlannerConfig
 from .cycle import Cycle, PlanResult
@@ -193,6 +194,8 @@ class Planner:
         self._aligned_from: NDArray | None = None   # odom pose of the last scan matched
         self._goal: tuple[NDArray, NDArray] | None = None   # (in odom, in the memory's frame)
         self._planned_from: NDArray | None = None   # the last cycle's pose (memory's frame)
+        #: Returns of the last scan taken in that lie on walls the memory is sure of.
+        self._memory_walls = 0
         #: Odometry's distance and turn scales, learnt (with odometry_calibration).
         self.odometry = OdometryCalibration()
 
@@ -243,11 +246,17 @@ class Planner:
                                            cfg.obstacle_range)
             self._perception = Perception(seen, seen_base, odom_scan_pose, goal, transient,
                                           tracks.trail)
+        obstacles = points
+        if cfg.geodesic:   # what the lidar cannot see now, the memory remembers
+            blind = blind_obstacles(self.memory.grid, pose, compose(scan_pose, cfg.laser_mount),
+                                    scan, local_radius(cfg), cfg.robot_radius, cfg.polygon)
+            obstacles = np.vstack((points, blind)) if len(blind) else points
         cycle = Cycle(cfg, now, cfg.period, pose, goal, points, tracks=tracks,
                       previous=self.previous,
                       memory_scans=self.memory.grid.scans + (self._perception is not None),
+                      memory_walls=self._memory_walls,
                       scan_age=now - scan.stamp if math.isfinite(scan.stamp) else 0.0,
-                      **_situation(pose, goal, points))
+                      **_situation(pose, goal, obstacles))
         result = self._run_stages(cycle)
         result = dataclasses.replace(result, pose=pose, correction=self.correction)
         self._planned_from = pose
@@ -293,7 +302,10 @@ class Planner:
             self._align(seen.scan, seen.base, seen.scan_pose)
         if len(seen.trail):
             self.memory.clear(seen.trail)
-        self.memory.integrate(seen.scan, self.in_map(seen.scan_pose), seen.goal, seen.transient)
+        placed = self.in_map(seen.scan_pose)
+        self.memory.integrate(seen.scan, placed, seen.goal, seen.transient)
+        self._memory_walls = int(np.count_nonzero(self._on_walls(to_parent(placed,
+                                                                           seen.base))))
 
     def in_map(self, pose: ArrayLike) -> NDArray[np.float64]:
         """An odom pose (x, y, yaw) in the memory's frame (odom corrected by the scan
