@@ -408,11 +408,9 @@ def test_a_walls_end_is_found_and_returns_beyond_it_do_not_pull():
 
 @pytest.mark.core
 def test_with_the_alignment_the_robot_stands_until_its_first_walls_are_established():
-    """The memory's frame is odom at the start: the first scans are taken standing
-    (``mapping``, a stop) until the memory holds FIRST_SCANS of them and the last put
-    FIRST_WALLS returns on established walls (three hits: once the third scan is in),
-    so that a first turn's drift is not drawn into the walls everything after is
-    matched to; then never again. Without the alignment it drives at once."""
+    """The memory's frame is odom at the start: the first FIRST_SCANS scans are taken
+    standing (``mapping``, a stop), so that a first turn's drift is not drawn into the
+    walls everything after is matched to. Without the alignment it drives at once."""
     from subapf_planner.core.gates import FIRST_SCANS
     from subapf_planner.core.status import Status
     walls = room()
@@ -420,7 +418,7 @@ def test_with_the_alignment_the_robot_stands_until_its_first_walls_are_establish
         planner = Planner(PlannerConfig(scan_alignment=aligned, laser_x=0.0, laser_y=0.0,
                                         laser_yaw=0.0))
         statuses = []
-        for k in range(FIRST_SCANS + 3):
+        for k in range(FIRST_SCANS + 1):
             scan = Scan(ranges_from(walls, (0.0, 0.0, 0.0)), 0.0, math.radians(1.0), 0.12,
                         3.5, 0.2 * (k + 1))
             r = planner.step(np.zeros(3), (2.0, -1.0), scan, now=0.2 * (k + 1))
@@ -428,25 +426,8 @@ def test_with_the_alignment_the_robot_stands_until_its_first_walls_are_establish
             if r.command.status is Status.MAPPING:
                 assert (r.command.v, r.command.w) == (0.0, 0.0)
         mapping = [s is Status.MAPPING for s in statuses]
-        assert mapping == ([True] * FIRST_SCANS + [False] * 3 if aligned
-                           else [False] * (FIRST_SCANS + 3))
-
-
-@pytest.mark.core
-def test_with_no_wall_in_reach_the_stand_ends_after_mapping_time():
-    """In an open hall (nothing within the lidar's range) no wall is established: the
-    robot stands MAPPING_TIME, then drives, and does not stand again."""
-    from subapf_planner.core.gates import MAPPING_TIME
-    from subapf_planner.core.status import Status
-    planner = Planner(PlannerConfig())
-    statuses = []
-    for k in range(20):
-        t = 0.2 * (k + 1)
-        scan = Scan(np.full(360, np.inf), 0.0, math.radians(1.0), 0.12, 3.5, t)
-        statuses.append(planner.step(np.zeros(3), (2.0, -1.0), scan, now=t).command.status)
-    first = [s is Status.MAPPING for s in statuses].index(False)
-    assert first == round(MAPPING_TIME / 0.2)
-    assert Status.MAPPING not in statuses[first:]
+        assert mapping == ([True] * (FIRST_SCANS - 1) + [False] * 2 if aligned
+                           else [False] * (FIRST_SCANS + 1))
 
 
 @pytest.mark.core

@@ -15,7 +15,7 @@ from sensor_msgs.msg import LaserScan
 
 from subapf_planner.core.command import Command, forward_blocked
 from subapf_planner.core.config import METHODS, PlannerConfig
-from subapf_planner.core.gates import MAPPING_TIME
+from subapf_planner.core.gates import FIRST_SCANS
 from subapf_planner.core.loop import DecisionLoop, Supervision
 from subapf_planner.core.planner import Planner, PlanResult, plan
 from subapf_planner.core.scan import Scan, geometry_warning
@@ -146,12 +146,12 @@ def test_fuzz_node(node, ranges, angle_min, inc, rmin, rmax, angle_max, frame, x
 
 def drive(node, scan, pose=(0.0, 0.0), goal=(3.0, 0.0), q=(0, 0, 0, 1), stamp=0):
     """The decision of a fresh loop on these inputs, once past the first cycles of a new
-    memory (``stopped: mapping``, MAPPING_TIME at most)."""
+    memory (``stopped: mapping``, at most FIRST_SCANS of them)."""
     cap = Captured(node)
     node._on_goal(goal_msg(*goal))
     node._on_scan(scan)
     node._on_odom(odom_msg(*pose, q, stamp=stamp))
-    for _ in range(round(MAPPING_TIME * node.ctl.cfg.planning_frequency) + 2):
+    for _ in range(FIRST_SCANS + 1):
         node._on_timer()
         if not cap.decisions or cap.decisions[-1].reason != 'mapping':
             break

@@ -87,9 +87,6 @@ class Cycle:
     previous: tuple[float, float]
     #: Scans in the memory, this cycle's counted (0 without the memory).
     memory_scans: int = 0
-    #: Returns of the last scan the memory took that lie on or beside walls it is sure of
-    #: (established cells; 0 without the memory).
-    memory_walls: int = 0
     #: How old the scan is [s] (now minus its stamp; 0 when unknown).
     scan_age: float = 0.0
     #: The navigation field (None: the Euclidean attraction) and whether it is new.

@@ -6,7 +6,7 @@ In the order :func:`~subapf_planner.core.pipeline.stage_names` runs them:
   approach is over: see :class:`Goal`) or inside an obstacle (a laser point within
   ``robot_radius`` of it);
 * ``mapping`` (with the scan alignment): the robot stands until the memory holds its
-  first scans and walls, so that the memory's frame is odom at the start;
+  first scans, so that the memory's frame is odom at the start;
 * ``reachability`` (with the memory): the navigation field to the goal, and
   ``goal_unreachable`` when the memory holds no way to it.
 """
@@ -21,20 +21,13 @@ from numpy.typing import ArrayLike, NDArray
 from .config import PlannerConfig
 from .cycle import Cycle, Stage
 from .memory import NavigationMemory
-from .odometry_calibration import MIN_MATCHED
 from .sampling import clearance
 from .status import Status
 
 #: With the scan alignment, the robot stands until the memory holds this many scans
-#: (the occupancy grid's walls are established by three hits) and the last of them put
-#: FIRST_WALLS returns on walls it is sure of (what the odometry calibration's first
-#: keyframe needs: core/odometry_calibration.py MIN_MATCHED), for MAPPING_TIME [s] at
-#: most (an open hall shows no walls; a driver whose stamps do not move adds no scans).
-#: Through a noisy lidar three scans may establish no wall yet, and a first turn then
-#: draws its drift into every wall after it.
+#: (the occupancy grid's walls are established by three hits), for this many cycles at
+#: most (a scan repeated with the same stamp is not taken twice).
 FIRST_SCANS = 3
-FIRST_WALLS = MIN_MATCHED
-MAPPING_TIME = 2.0
 #: Inside goal_tolerance the approach goes on while the robot gets this much closer to the
 #: goal than it has been [m] at least once every ARRIVAL_PATIENCE [s]: a cycle or two
 #: spent turning towards the goal (a few centimetres off its axis the heading to it is
@@ -110,29 +103,23 @@ class Goal(Stage):
 
 
 class Mapping(Stage):
-    """``mapping`` while the memory holds fewer than FIRST_SCANS scans or its last scan
-    put fewer than FIRST_WALLS returns on established walls, for MAPPING_TIME at most;
-    once over, not again (until a new world); not once the robot is inside the goal
-    tolerance."""
+    """``mapping`` while the memory holds fewer than FIRST_SCANS scans, for FIRST_SCANS
+    cycles at most; not once the robot is inside the goal tolerance."""
 
     name = 'mapping'
 
     def __init__(self) -> None:
-        self._since: float | None = None   # when the stand began [s]
-        self._over = False
+        self._cycles = 0   # cycles stood so far
 
     def forget(self) -> None:
-        self._since, self._over = None, False
+        self._cycles = 0
 
     def run(self, cycle: Cycle) -> Cycle:
-        if self._over or cycle.goal_distance <= cycle.cfg.goal_tolerance:
+        if cycle.goal_distance <= cycle.cfg.goal_tolerance \
+                or cycle.memory_scans >= FIRST_SCANS or self._cycles >= FIRST_SCANS:
             return cycle
-        if self._since is None:
-            self._since = cycle.now
-        self._over = (cycle.memory_scans >= FIRST_SCANS
-                      and cycle.memory_walls >= FIRST_WALLS) \
-            or cycle.now - self._since >= MAPPING_TIME
-        return cycle if self._over else cycle.with_(status=Status.MAPPING)
+        self._cycles += 1
+        return cycle.with_(status=Status.MAPPING)
 
 
 class Reachability(Stage):

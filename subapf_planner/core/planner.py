@@ -194,8 +194,6 @@ class Planner:
         self._aligned_from: NDArray | None = None   # odom pose of the last scan matched
         self._goal: tuple[NDArray, NDArray] | None = None   # (in odom, in the memory's frame)
         self._planned_from: NDArray | None = None   # the last cycle's pose (memory's frame)
-        #: Returns of the last scan taken in that lie on walls the memory is sure of.
-        self._memory_walls = 0
         #: Odometry's distance and turn scales, learnt (with odometry_calibration).
         self.odometry = OdometryCalibration()
 
@@ -254,7 +252,6 @@ class Planner:
         cycle = Cycle(cfg, now, cfg.period, pose, goal, points, tracks=tracks,
                       previous=self.previous,
                       memory_scans=self.memory.grid.scans + (self._perception is not None),
-                      memory_walls=self._memory_walls,
                       scan_age=now - scan.stamp if math.isfinite(scan.stamp) else 0.0,
                       **_situation(pose, goal, obstacles))
         result = self._run_stages(cycle)
@@ -302,10 +299,7 @@ class Planner:
             self._align(seen.scan, seen.base, seen.scan_pose)
         if len(seen.trail):
             self.memory.clear(seen.trail)
-        placed = self.in_map(seen.scan_pose)
-        self.memory.integrate(seen.scan, placed, seen.goal, seen.transient)
-        self._memory_walls = int(np.count_nonzero(self._on_walls(to_parent(placed,
-                                                                           seen.base))))
+        self.memory.integrate(seen.scan, self.in_map(seen.scan_pose), seen.goal, seen.transient)
 
     def in_map(self, pose: ArrayLike) -> NDArray[np.float64]:
         """An odom pose (x, y, yaw) in the memory's frame (odom corrected by the scan
