@@ -10,8 +10,9 @@ small object with a ``name`` and a ``run(cycle) -> cycle``:
   first gate that sets ``status`` ends the gates;
 * one **proposer** (core/proposers.py: the APF step with circular sampling and its
   critics, the APF step alone, DWA) turns a cycle no gate stopped into a command;
-* **filters** (core/approach.py, core/filters.py) see every cycle's command and may replace it (the
-  approach to the goal inside its tolerance, the evasion of moving obstacles).
+* **filters** (core/approach.py, core/filters.py) see every cycle's command and may
+  replace it (the approach to the goal inside its tolerance, the evasion of moving
+  obstacles).
 
 Which stages run follows from the parameters (:func:`~subapf_planner.core.pipeline.
 stage_names`). A stage keeps what it must remember between cycles in itself, changes

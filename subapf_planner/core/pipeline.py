@@ -2,9 +2,9 @@
 
 A stage is registered here by name, in one of three kinds (core/cycle.py): gates
 (core/gates.py), proposers (core/proposers.py), filters (core/approach.py,
-core/filters.py). The
-parameters choose them (:func:`stage_names`); the sampling's scoring terms are chosen
-by ``critics`` (core/critics/). A new stage is one module and a line here.
+core/filters.py). The parameters choose them (:func:`stage_names`); the sampling's
+scoring terms are chosen by ``critics`` (core/critics/). A new stage is one module and
+a line here.
 """
 
 from __future__ import annotations
