@@ -421,23 +421,21 @@ def test_a_thinned_polyline_keeps_its_ends_and_its_spacing():
     np.testing.assert_allclose(thin[[0, -1]], zigzag[[0, -1]])
 
 
-@given(stamps=st.lists(st.integers(0, 40), min_size=1, max_size=30),
-       asked=st.integers(-10, 50))
+@given(stamps=st.lists(st.integers(0, 40), min_size=1, max_size=30, unique=True),
+       asked=st.integers(-100, 500))
 @settings(max_examples=200, deadline=None)
-def test_a_scan_is_placed_at_the_odometry_nearest_its_stamp(stamps, asked):
-    """DecisionLoop.pose_at: of the odometry kept (stamps never falling, repeats
-    allowed), the pose nearest the scan's stamp, the newest of equally near ones;
-    none within POSE_MATCH: the newest pose."""
-    from subapf_planner.core.loop import POSE_MATCH, DecisionLoop
+def test_the_odometry_at_a_stamp_is_interpolated_between_the_poses_around_it(stamps, asked):
+    """DecisionLoop.pose_between: of the odometry kept, the pose at the scan's stamp
+    interpolated between the two poses around it; before the oldest the oldest, after
+    the newest the newest (here x = the pose's index: the interpolation is np.interp)."""
+    from subapf_planner.core.loop import DecisionLoop
     loop = DecisionLoop(PlannerConfig())
     times = np.sort(np.asarray(stamps)) * 0.05
     for i, t in enumerate(times):
-        assert loop.update_odom(float(t), np.array([float(i), 0.0, 0.0]), float(t))
-    stamp = asked * 0.05
-    gaps = np.abs(times - stamp)
-    newest_nearest = len(times) - 1 - int(np.argmin(gaps[::-1]))
-    expected = newest_nearest if gaps[newest_nearest] <= POSE_MATCH else len(times) - 1
-    assert loop.pose_at(stamp)[0] == expected
+        assert loop.update_odom(float(t), np.array([float(i), -2.0 * i, 0.1 * i]), float(t))
+    stamp = asked * 0.005
+    x = np.interp(stamp, times, np.arange(len(times)))
+    np.testing.assert_allclose(loop.pose_between(stamp), [x, -2.0 * x, 0.1 * x], atol=1e-9)
 
 
 def test_a_scan_is_planned_from_the_odometry_interpolated_at_its_stamp(monkeypatch):

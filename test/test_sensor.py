@@ -242,7 +242,7 @@ def test_a_sweep_across_pi_is_deskewed_with_its_small_turn():
                                                                 2 * math.pi)]), t)
     motion = ctl.sweep_motion(scan)
     assert motion[2] == pytest.approx(turn * (n - 1) / n, abs=1e-6)
-    straight, _ = ctl._deskewed(scan)
+    straight, _, _ = ctl._deskewed(scan)
     pts = scan_to_points(straight, (0.0, 0.0, yaw0))
     assert len(pts) > 0.9 * n
     assert np.median(_off_walls(pts)) < 0.005 and np.percentile(_off_walls(pts), 95) < 0.025

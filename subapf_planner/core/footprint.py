@@ -83,6 +83,20 @@ class Footprint:
         """How far the footprint reaches ahead of the base frame's origin (largest x) [m]."""
         return float(self.vertices[:, 0].max())
 
+    def _in_frames(self, poses: NDArray[np.float64],
+                   points: NDArray[np.float64]) -> tuple[NDArray[np.float64], ...]:
+        """The points (m, 2) in each pose's (n, 3) frame: x and y (n, m) [m]."""
+        c, s = np.cos(poses[:, 2]), np.sin(poses[:, 2])
+        dx = points[None, :, 0] - poses[:, None, 0]
+        dy = points[None, :, 1] - poses[:, None, 1]
+        return c[:, None] * dx + s[:, None] * dy, -s[:, None] * dx + c[:, None] * dy
+
+    def _outside(self, fx: NDArray[np.float64], fy: NDArray[np.float64]) -> NDArray[np.float64]:
+        """How far points in the footprint's frame lie outside each edge's line (..., k)
+        [m]: inside the footprint where all are <= 0."""
+        normals, offsets = self._normals
+        return fx[..., None] * normals[:, 0] + fy[..., None] * normals[:, 1] - offsets
+
     def contact(self, poses: ArrayLike, points: ArrayLike, margin: float) -> NDArray[np.bool_]:
         """For each pose (n, 3) (x, y, yaw), whether a point (m, 2) lies within ``margin``
         [m] of the footprint placed there (or inside it)."""
@@ -90,30 +104,19 @@ class Footprint:
         pts = np.asarray(points, float).reshape(-1, 2)
         if pts.shape[0] == 0:
             return np.zeros(p.shape[0], bool)
-        normals, offsets = self._normals
-        c, s = np.cos(p[:, 2]), np.sin(p[:, 2])
-        dx = pts[None, :, 0] - p[:, None, 0]
-        dy = pts[None, :, 1] - p[:, None, 1]
-        # the points in each pose's frame (n, m)
-        fx, fy = c[:, None] * dx + s[:, None] * dy, -s[:, None] * dx + c[:, None] * dy
+        fx, fy = self._in_frames(p, pts)
         reach = self.circumscribed + margin
         near = fx * fx + fy * fy <= reach * reach
         if not near.any():
             return np.zeros(p.shape[0], bool)
-        out = fx[..., None] * normals[:, 0] + fy[..., None] * normals[:, 1] - offsets
-        return np.any(near & np.all(out <= margin, axis=-1), axis=1)
+        return np.any(near & np.all(self._outside(fx, fy) <= margin, axis=-1), axis=1)
 
     def covers(self, pose: ArrayLike, points: ArrayLike) -> NDArray[np.bool_]:
         """Per point (m, 2), whether it lies inside the footprint placed at ``pose``
         (x, y, yaw)."""
-        x, y, yaw = (float(v) for v in np.asarray(pose, float).ravel()[:3])
-        pts = np.asarray(points, float).reshape(-1, 2)
-        c, s = math.cos(yaw), math.sin(yaw)
-        dx, dy = pts[:, 0] - x, pts[:, 1] - y
-        fx, fy = c * dx + s * dy, -s * dx + c * dy
-        normals, offsets = self._normals
-        out = fx[:, None] * normals[:, 0] + fy[:, None] * normals[:, 1] - offsets
-        return np.all(out <= 0.0, axis=1)
+        p = np.asarray(pose, float).ravel()[:3].reshape(1, 3)
+        fx, fy = self._in_frames(p, np.asarray(points, float).reshape(-1, 2))
+        return np.all(self._outside(fx[0], fy[0]) <= 0.0, axis=-1)
 
     def turn_contact(self, pose: ArrayLike, turn: float, points: ArrayLike,
                      margin: float) -> bool:

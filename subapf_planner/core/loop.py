@@ -38,8 +38,6 @@ from .supervisors import SUPERVISORS, Recoveries
 
 #: Odometry poses kept to place each scan at the pose it was taken from.
 POSE_HISTORY = 100
-#: A scan is placed with the odometry pose nearest its stamp, if within this [s].
-POSE_MATCH = 0.1
 #: An input stamped more than this [s] after the clock is not taken: it was sent before
 #: the clock jumped back (a restarted simulation) or by a clock out of step.
 FUTURE_STAMP = 1.0
@@ -121,8 +119,8 @@ class DecisionLoop:
         self.state = State.IDLE
         self.reason = 'no goal'
         self.supervisors = tuple(cls() for cls in SUPERVISORS)
-        #: The last scan, and as the obstacles and as the memory take it (_deskewed)
-        self._deskew: tuple[Scan, Scan, Scan] | None = None
+        #: The last scan, as the obstacles and as the memory take it, and its pose (_deskewed)
+        self._deskew: tuple[Scan, Scan, Scan, np.ndarray] | None = None
         self.recoveries = Recoveries()
 
     @property
@@ -267,18 +265,6 @@ class DecisionLoop:
         self.poses.append((stamp, self.pose))
         return not jumped
 
-    def pose_at(self, stamp: float) -> np.ndarray:
-        """Odometry pose nearest ``stamp`` (within POSE_MATCH; the newest on a tie),
-        else the newest."""
-        best, nearest = math.inf, self.pose
-        for t, pose in reversed(self.poses):   # stamps never fall: nearer, then farther
-            gap = abs(t - stamp)
-            if gap > best:
-                break
-            if gap < best:
-                best, nearest = gap, pose
-        return nearest if best <= POSE_MATCH else self.pose
-
     def pose_between(self, stamp: float) -> np.ndarray:
         """The odometry pose at ``stamp`` [s], interpolated between the two poses around
         it (the oldest or the newest beyond them)."""
@@ -298,30 +284,33 @@ class DecisionLoop:
                 break
         return poses[-1][1]
 
-    def sweep_motion(self, scan: Scan) -> np.ndarray:
+    def sweep_motion(self, scan: Scan, start: np.ndarray | None = None) -> np.ndarray:
         """base_footprint's motion (x, y, yaw) from the scan's first beam to its last, in
-        its pose at the first, as odometry says (zero for a scan taken at once)."""
+        its pose at the first (``start``: pose_between(scan.stamp) if not given), as
+        odometry says (zero for a scan taken at once)."""
         n = np.size(scan.ranges)
         if scan.beam_interval <= 0.0 or n < 2 or not math.isfinite(scan.stamp):
             return np.zeros(3)
-        start = self.pose_between(scan.stamp)
+        start = self.pose_between(scan.stamp) if start is None else start
         end = self.pose_between(scan.stamp + (n - 1) * scan.beam_interval)
         return np.asarray(compose(invert(start), end))
 
-    def _deskewed(self, scan: Scan) -> tuple[Scan, Scan]:
+    def _deskewed(self, scan: Scan) -> tuple[Scan, Scan, np.ndarray]:
         """The scan as if taken at its first beam's instant (core/scan.py deskew), its
         ranges' noise averaged along each surface (core/scan.py denoise, by the lidar's
         range_noise_*): for the obstacles and the tracker, and for the memory and the
         alignment, where returns at grazing incidence keep their ranges
-        (GRAZING_MEMORY); once per scan."""
+        (GRAZING_MEMORY); and the odometry pose at that instant, interpolated
+        (pose_between); once per scan."""
         if self._deskew is None or self._deskew[0] is not scan:
             cfg = self.cfg
-            straight = deskew(scan, self.sweep_motion(scan), cfg.laser_mount,
+            start = self.pose_between(scan.stamp)
+            straight = deskew(scan, self.sweep_motion(scan, start), cfg.laser_mount,
                               cfg.deskew_bearings)
             self._deskew = (scan, *denoise_each(straight, cfg.range_noise_floor,
                                                 cfg.range_noise_fraction,
-                                                (GRAZING_OBSTACLES, GRAZING_MEMORY)))
-        return self._deskew[1], self._deskew[2]
+                                                (GRAZING_OBSTACLES, GRAZING_MEMORY)), start)
+        return self._deskew[1], self._deskew[2], self._deskew[3]
 
     def silent(self, now: float) -> tuple[bool, bool]:
         """Whether the scan, and the odometry, are silent at ``now`` [s]: none taken
@@ -356,11 +345,11 @@ class DecisionLoop:
             decision = s.before(self, now)
             if decision is not None:
                 return decision
-        scan, for_memory = self._deskewed(self.scan)
         # the scan's pose where the sweep began, interpolated as _deskewed placed its beams
         # (the nearest odometry sample is up to half an odometry period off: at 2 m/s
         # and 20 Hz 5 cm, and the odometry calibration learnt that as a scale)
-        result = self.planner.step(self.pose, self.goal, scan, self.pose_between(self.scan.stamp),
+        scan, for_memory, scan_pose = self._deskewed(self.scan)
+        result = self.planner.step(self.pose, self.goal, scan, scan_pose,
                                    now=now, goal_in_map=self.goal_in_map,
                                    memory_scan=for_memory)
         for s in self.supervisors:
