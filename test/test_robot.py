@@ -84,6 +84,34 @@ def test_the_simulated_body_is_built_from_the_description(key):
         assert [float(c.get('radius')) for c in body] == [robot.radius] and meshes == []
 
 
+@pytest.mark.parametrize('key', sorted(ROBOTS))
+def test_the_planner_asks_no_more_acceleration_than_the_base_gives(key):
+    """Driving at half its top speed and turning at its top rate, then told to stop, the
+    simulated base stands still no later than the planner's acceleration limits say
+    (10 % and a physics step of slack): a planner that takes its base to brake faster
+    than the wheels' grip allows swings a corner into what it meant to stop short of
+    (the Jackal with its controller's 20 m/s^2 and 25 rad/s^2, 0.16 s, took 0.3 s)."""
+    robot = ROBOTS[key]
+    cfg = PlannerConfig.for_robot(robot)
+    empty = parse_world({'name': 'empty', 'start': [0.0, 0.0, 0.0], 'goal': [9.0, 9.0],
+                         'obstacles': []})
+    with RobotSim(empty, SimConfig(robot=key, sensor='ideal', scan_threads=1)) as sim:
+        for _ in range(40):
+            sim.set_command(0.5 * robot.max_linear_velocity, robot.max_angular_velocity)
+            sim.step(0.05)
+        v0, w0 = sim.true_velocity()
+        assert v0 > 0.25 * robot.max_linear_velocity and w0 > 0.5 * robot.max_angular_velocity
+        v, w, t = v0, w0, 0.0
+        while abs(v) > 0.05 * v0 or abs(w) > 0.05 * w0:
+            assert t < 2.0, (v, w)
+            sim.set_command(0.0, 0.0)
+            sim.step(0.005)
+            t += 0.005
+            v, w = sim.true_velocity()
+    planned = max(v0 / cfg.max_linear_acceleration, w0 / cfg.max_angular_acceleration)
+    assert t <= 1.1 * planned + 0.005, (t, planned)
+
+
 def test_the_burgers_body_is_the_stand_in_its_results_were_measured_with():
     """The burger's generated URDF has the numbers of the hand-written stand-in the
     recorded results came from (wheels 0.033 m, 0.160 m apart; body 0.105 m, 1 kg)."""

@@ -248,7 +248,7 @@ JACKAL = RobotDescription(
     "are estimates; the accelerations are what the wheels' grip gives, not the "
     "controller's 20 m/s^2 and 25 rad/s^2: the simulated base (friction 1.0) brakes "
     'from 1 m/s and 4 rad/s to a stop in 0.3 s, 3.4 m/s^2 and 13 rad/s^2 '
-    '(test_robots.py::test_the_planner_asks_no_more_acceleration_than_the_base_gives)')
+    '(test_robot.py::test_the_planner_asks_no_more_acceleration_than_the_base_gives)')
 #: The robots config/robots/ has a parameter file for, by file name.
 ROBOTS = {'burger': BURGER, 'waffle_pi': WAFFLE_PI, 'turtlebot4': TURTLEBOT4, 'jackal': JACKAL}
 
