@@ -305,11 +305,14 @@ class DecisionLoop:
         if self._deskew is None or self._deskew[0] is not scan:
             cfg = self.cfg
             start = self.pose_between(scan.stamp)
-            straight = deskew(scan, self.sweep_motion(scan, start), cfg.laser_mount,
-                              cfg.deskew_bearings)
-            self._deskew = (scan, *denoise_each(straight, cfg.range_noise_floor,
-                                                cfg.range_noise_fraction,
-                                                (GRAZING_OBSTACLES, GRAZING_MEMORY)), start)
+            motion = self.sweep_motion(scan, start)
+            straight = deskew(scan, motion, cfg.laser_mount, cfg.deskew_bearings)
+            exact = deskew(scan, motion, cfg.laser_mount, True)
+            obstacles, = denoise_each(straight, cfg.range_noise_floor,
+                                      cfg.range_noise_fraction, (GRAZING_OBSTACLES,))
+            memory, = denoise_each(exact, cfg.range_noise_floor, cfg.range_noise_fraction,
+                                   (GRAZING_MEMORY,))
+            self._deskew = (scan, obstacles, memory, start)
         return self._deskew[1], self._deskew[2], self._deskew[3]
 
     def silent(self, now: float) -> tuple[bool, bool]:
