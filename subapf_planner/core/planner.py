@@ -130,6 +130,24 @@ def _near(points: NDArray, centres: NDArray, radii: NDArray) -> NDArray[np.bool_
     return np.any(d <= radii + MOVER_MARGIN, axis=1)
 
 
+def _on_grid(flags: NDArray[np.bool_] | None, grid: Scan, exact: Scan
+             ) -> NDArray[np.bool_] | None:
+    """Per-beam ``flags`` of a scan on its grid of angles (``grid``), for the returns of
+    the same sweep kept at their own bearings (``exact``: each return of its beam, at its
+    direction; core/scan.py deskew): each return takes the flag of the grid's beam its
+    direction is nearest (the beam it landed in there). Unchanged when both scans are on
+    the grid or both keep their bearings."""
+    if flags is None or exact.bearings is None or grid.bearings is not None or not len(flags):
+        return flags
+    n = len(flags)
+    with np.errstate(invalid='ignore'):
+        k = np.rint((exact.bearings - grid.angle_min) / grid.angle_increment)
+    k = np.where(np.isfinite(k), k, 0).astype(np.int64)
+    full = n * abs(grid.angle_increment) >= 2.0 * math.pi - 0.5 * abs(grid.angle_increment)
+    k = np.mod(k, n) if full else np.clip(k, 0, n - 1)
+    return flags[k]
+
+
 class Planner:
     """The planning step with its state: the last command (acceleration limits), the
     stages (core/pipeline.py) with what they remember, and, with the geodesic
@@ -239,9 +257,10 @@ class Planner:
             seen, seen_base = scan, base
             if memory_scan is not None and memory_scan is not scan \
                     and np.size(memory_scan.ranges) == np.size(scan.ranges):
-                seen = memory_scan   # (transient: per beam, the same beams)
+                seen = memory_scan
                 seen_base = scan_to_points(seen, (0.0, 0.0, 0.0), cfg.laser_mount,
                                            cfg.obstacle_range)
+                transient = _on_grid(transient, scan, seen)
             self._perception = Perception(seen, seen_base, odom_scan_pose, goal, transient,
                                           tracks.trail)
         obstacles = points
