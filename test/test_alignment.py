@@ -13,7 +13,7 @@ from subapf_planner.core.alignment import (
     DRIFT_YAW_PER_M,
     MAX_STEP_XY,
     MIN_MATCHED,
-    MIN_WALL_SCANS,
+    MIN_WALL_AGE,
     _ends,
     align,
     distance_field,
@@ -24,9 +24,11 @@ from subapf_planner.core.config import PlannerConfig
 from subapf_planner.core.occupancy import ESTABLISHED, NOT_ESTABLISHED, OccupancyGrid
 from subapf_planner.core.planner import Planner
 from subapf_planner.core.robot import to_parent
-from subapf_planner.core.scan import Scan
+from subapf_planner.core.scan import Scan, scans_in
 
 RES = 0.05
+#: Scans a wall must have stood to be matched by a small piece, at the default 5 Hz.
+YOUNG = scans_in(MIN_WALL_AGE, PlannerConfig().period)
 
 
 def grid_with(walls: np.ndarray) -> OccupancyGrid:
@@ -340,11 +342,11 @@ def test_one_mover_sized_thing_is_no_landmark_two_or_a_wall_are():
 
 
 @pytest.mark.core
-def test_small_things_match_only_walls_that_have_stood_min_wall_scans():
+def test_small_things_match_only_walls_that_have_stood_min_wall_age():
     """The grid notes the scan from which a cell has been established (three hits) and
     forgets it once misses leave it no longer occupied. The field tells which walls are
-    young (established fewer than MIN_WALL_SCANS scans ago): the returns of a piece no
-    longer than a mover match only older ones (a person who stood in the memory a few
+    young (established fewer than MIN_WALL_AGE ago: YOUNG scans at 5 Hz): the returns of
+    a piece no longer than a mover match only older ones (a person who stood in the memory a few
     seconds is not a landmark), a wall's returns match at once."""
     from subapf_planner.core.tracking import clusters
     g = OccupancyGrid(RES, 20.0, hit_places=True)
@@ -355,10 +357,10 @@ def test_small_things_match_only_walls_that_have_stood_min_wall_scans():
     for _ in range(3):
         g.update(scan, (0.0, 0.0, 0.0))
     assert g.log_odds[cell] >= ESTABLISHED and g.established_at[cell] == 3
-    for _ in range(MIN_WALL_SCANS + 2):
+    for _ in range(YOUNG + 2):
         f = distance_field(g.log_odds, g.origin, RES, np.array([[1.0, 0.0]]), 0.4,
-                           g.hit_offset, g.established_at, g.scans)
-        assert f.lookup(np.array([[1.0, 0.0]]))[3][0] == (g.scans - 3 < MIN_WALL_SCANS)
+                           g.hit_offset, g.established_at, g.scans, YOUNG)
+        assert f.lookup(np.array([[1.0, 0.0]]))[3][0] == (g.scans - 3 < YOUNG)
         g.update(scan, (0.0, 0.0, 0.0))
     ranges[0] = 2.0                                   # it went: beams now pass through
     for _ in range(10):
@@ -372,12 +374,12 @@ def test_small_things_match_only_walls_that_have_stood_min_wall_scans():
         g = grid_with(walls)
         base = seen_from(walls, true, noise=0.0)
         pieces = clusters(base, 0.15)[0]
-        for age in (MIN_WALL_SCANS - 1, MIN_WALL_SCANS):
+        for age in (YOUNG - 1, YOUNG):
             since = np.where(g.log_odds >= ESTABLISHED, 100 - age, NOT_ESTABLISHED)
             f = distance_field(g.log_odds, g.origin, RES, base, 0.4, None,
-                               since.astype(np.int32), 100)
+                               since.astype(np.int32), 100, YOUNG)
             m = align(base, true, f, pieces, 1.2)
-            assert m.accepted is (not small or age >= MIN_WALL_SCANS)
+            assert m.accepted is (not small or age >= YOUNG)
 
 
 @pytest.mark.core

@@ -26,7 +26,7 @@ as Hector SLAM's, with point-to-line residuals as in ICP), where
   keeps odometry's estimate along it;
 * among people: the returns of a piece of the scan no longer than a mover
   (core/tracking.clusters) match only cells that have been walls for
-  MIN_WALL_SCANS (someone who walked slowly into the memory before the tracker
+  MIN_WALL_AGE (someone who walked slowly into the memory before the tracker
   knew it moved has not stood that long where it is seen now), and a match needs
   MIN_PIECES landmarks (:func:`landmarks`: one person-sized thing cannot tell a
   walker from the robot's own drift);
@@ -58,11 +58,12 @@ from .scan import range_sigma
 from .tracking import extents
 
 #: A piece of the scan no longer than a mover (a person, a chair, a post) is matched only
-#: to cells established this many scans ago or more (5 s at the LDS-01's 5 Hz): a person
+#: to cells established this long ago or more [s] (counted in scans at the planning rate,
+#: core/scan.scans_in; the memory's NavigationMemory.align): a person
 #: who walked slowly into the memory, before the tracker knew it moved, has not stood
 #: that long where it is seen now. Walls (longer pieces) match at once: a room's walls
 #: must correct the pose from the first scans, or the room is drawn with the drift.
-MIN_WALL_SCANS = 25
+MIN_WALL_AGE = 5.0
 #: Returns farther than this from every established cell take no part [m].
 MAX_CORRESPONDENCE = 0.06
 #: A return farther than this along the wall from its nearest wall point takes no part
@@ -113,10 +114,10 @@ class DistanceField:
     in ``table``), and per wall cell (k of them) a row of ``table`` (k + 1, 6): the wall
     point (x, y) [m], the wall's unit normal there (x, y), ``inf`` where the memory's
     wall ends but the wall may go on (:func:`_ends`; else 0: added to the distance, it
-    leaves no distance there) and 1 where it was established fewer than MIN_WALL_SCANS
-    scans before the field was made (OccupancyGrid.established_at; else 0). The last
-    row, k, is for points off the window: no wall point, an end (no distance), not
-    new. The table is per wall cell, not per window cell: a field is made every few
+    leaves no distance there) and 1 where it was established fewer than
+    ``min_wall_scans`` scans before the field was made (OccupancyGrid.established_at;
+    else 0). The last row, k, is for points off the window: no wall point, an end (no
+    distance), not new. The table is per wall cell, not per window cell: a field is made every few
     scans and read at a few hundred returns, so what a return needs is looked up, in
     one gather, when it is asked for."""
 
@@ -132,7 +133,7 @@ class DistanceField:
         the distance (n,) [m], inf outside the window and where the nearest wall point is
         where the memory's wall ends but the wall may go on (a return there may lie
         beyond it, where the memory has not seen the wall yet), and whether that wall
-        cell has been established for fewer than MIN_WALL_SCANS scans (n,) (False
+        cell has been established for fewer than ``min_wall_scans`` scans (n,) (False
         outside the window)."""
         cells = np.floor((points - self.origin) / self.resolution).astype(np.int64)
         h, w = self.shape
@@ -185,14 +186,15 @@ def distance_field(log_odds: NDArray[np.float32], origin: NDArray[np.float64],
                    resolution: float, around: NDArray[np.float64], reach: float,
                    hit_offset: NDArray[np.float32] | None = None,
                    established_at: NDArray[np.int32] | None = None,
-                   scans: int = 0) -> DistanceField | None:
+                   scans: int = 0, min_wall_scans: int = 0) -> DistanceField | None:
     """The field of the established cells of a log-odds grid (corner of cell (0, 0) at
     ``origin``) within ``reach`` [m] of the box of the points ``around`` (n, 2); None
     when that window holds no established cell. ``hit_offset`` (the grid's, h x w x 2
     [m]) places each wall point where the returns fell in its cell: matching to cell
     centres would pull the pose by up to half a cell. ``established_at`` (the grid's,
     h x w: the scan from which each cell has been established) and ``scans`` (the
-    grid's count now) tell how long each wall has stood (DistanceField.lookup)."""
+    grid's count now) tell how long each wall has stood: those established fewer than
+    ``min_wall_scans`` scans ago are young (DistanceField.lookup)."""
     lo_xy = around.min(axis=0) - reach
     hi_xy = around.max(axis=0) + reach
     n_rows, n_cols = log_odds.shape
@@ -216,7 +218,7 @@ def distance_field(log_odds: NDArray[np.float32], origin: NDArray[np.float64],
     normals = _normals(wall)
     new = np.zeros(wall_rows.size, bool) if established_at is None else \
         established_at[r0:r1, c0:c1][wall_rows, wall_cols].astype(np.int64) \
-        > scans - MIN_WALL_SCANS
+        > scans - min_wall_scans
     end = _ends(wall, normals, log_odds[r0:r1, c0:c1] < 0.0)
     table = np.zeros((wall_rows.size + 1, 6))
     table[:-1, 0:2], table[:-1, 2:4] = point, normals
@@ -307,7 +309,7 @@ def align(base_points: NDArray[np.float64], predicted: NDArray[np.float64],
     cluster label, n), a match is accepted only when its matched returns make MIN_PIECES
     landmarks (:func:`landmarks`; ``mover_size`` [m] the longest a mover can be), and
     the returns of pieces no longer than that match only walls that have stood
-    MIN_WALL_SCANS (DistanceField.lookup)."""
+    MIN_WALL_AGE (DistanceField.lookup)."""
     prior = np.asarray(predicted, float).copy()
     if field is None or len(base_points) < MIN_MATCHED:
         return Match(prior, False, 0, math.nan)

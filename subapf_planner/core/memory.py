@@ -30,13 +30,13 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy import ndimage
 
-from .alignment import DistanceField, Match, align, distance_field
+from .alignment import MIN_WALL_AGE, DistanceField, Match, align, distance_field
 from .config import PlannerConfig
 from .known_map import KnownMap
 from .navigation import NavigationField, compute_field, nearest_free
 from .occupancy import ESTABLISHED, NOT_ESTABLISHED, OccupancyGrid
 from .robot import compose, to_parent
-from .scan import Scan
+from .scan import Scan, scans_in
 from .tracking import clusters
 
 #: Goals closer than this are the same goal (the field's, the controller's) [m].
@@ -288,7 +288,8 @@ class NavigationMemory:
             g = self.grid
             self._distance = distance_field(g.log_odds, g.origin, g.resolution, here,
                                             DISTANCE_FIELD_MARGIN, g.hit_offset,
-                                            g.established_at, g.scans)
+                                            g.established_at, g.scans,
+                                            scans_in(MIN_WALL_AGE, self.cfg.period))
             self._distance_age = 0
         self._distance_age += 1
         return align(base, pred, self._distance, pieces, self.cfg.max_mover_size,

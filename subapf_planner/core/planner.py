@@ -50,9 +50,9 @@ from .pipeline import Pipeline
 from .proposers import local_radius
 from .robot import compose, invert, to_parent
 from .sampling import clearance
-from .scan import Scan, ScanError, range_sigma, scan_to_points
+from .scan import Scan, ScanError, range_sigma, scan_to_points, scans_in
 from .status import Status
-from .tracking import NO_TRACKS, STANDING_SCANS, Tracker, Tracks
+from .tracking import NO_TRACKS, STANDING_TIME, Tracker, Tracks
 
 __all__ = ['Perception', 'PlanResult', 'Planner', 'goal_status', 'input_status',
            'local_radius', 'plan']
@@ -114,8 +114,9 @@ def plan(cfg: PlannerConfig, pose: ArrayLike, goal: ArrayLike, obstacles: ArrayL
     return Pipeline(cfg, None).proposer.run(cycle).result
 
 
-def _tracker_settings(cfg: PlannerConfig) -> tuple[float, float, float, float]:
-    return (cfg.cluster_gap, cfg.max_mover_size, cfg.track_gate, cfg.moving_speed)
+def _tracker_settings(cfg: PlannerConfig) -> tuple[float, float, float, float, float]:
+    return (cfg.cluster_gap, cfg.max_mover_size, cfg.track_gate, cfg.moving_speed,
+            cfg.period)
 
 
 def _tracker(cfg: PlannerConfig) -> Tracker:
@@ -422,7 +423,7 @@ class Planner:
                now: float) -> tuple[Tracks, NDArray[np.bool_] | None]:
         """The tracks of this scan (its returns ``points`` in the memory's frame, taken
         at ``scan_pose``), and per beam whether it returned from a moving one. The
-        tracker is told which returns are on what has stood for STANDING_SCANS scans,
+        tracker is told which returns are on what has stood for STANDING_TIME,
         within two standard deviations of their range noise along their rays
         (NavigationMemory.standing)."""
         t = scan.stamp if math.isfinite(scan.stamp) else now
@@ -434,7 +435,8 @@ class Planner:
         beams = np.flatnonzero(scan.valid(self.cfg.obstacle_range))   # those of points
         tracks = self.tracker.update(points, t, self.memory.log_odds_at(points),
                                      self.memory.standing(points, origin, 2.0 * noise,
-                                                          STANDING_SCANS),
+                                                          scans_in(STANDING_TIME,
+                                                                   self.cfg.period)),
                                      beams * scan.beam_interval)
         transient = np.zeros(np.size(scan.ranges), bool)
         transient[beams] = tracks.held_points

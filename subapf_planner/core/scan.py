@@ -87,6 +87,13 @@ class Scan:
         return valid_beams(self.ranges, self.range_min, self.range_max, max_range)
 
 
+def scans_in(seconds: float, period: float) -> int:
+    """How many scans make ``seconds`` [s] when one is taken each ``period`` [s] (the
+    planner takes one a planning cycle; at least one). What the memory and the tracker
+    wait for is a time: the same seconds at 5 Hz and at 20 Hz."""
+    return max(1, round(seconds / period))
+
+
 def beam_angles(n: int, angle_min: float, angle_increment: float) -> NDArray[np.float64]:
     """Angle of each beam in the laser frame [rad]."""
     return angle_min + angle_increment * np.arange(n)

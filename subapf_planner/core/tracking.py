@@ -10,7 +10,7 @@ tracked. The others are
 associated with the tracks predicted to this scan's time (Hungarian assignment,
 scipy, within ``track_gate`` and the prediction's uncertainty: GATE_CHI2) and update
 their filter; unmatched clusters start
-tentative tracks, and a track unseen for MAX_MISSES scans is dropped.
+tentative tracks, and a track unseen for MAX_UNSEEN seconds is dropped.
 
 The filter (per track, vectorised over all tracks) is the constant-velocity
 model: state (x, y, vx, vy) [m, m/s], white-acceleration process noise of
@@ -25,7 +25,7 @@ first seen at some time (NEW_MOVE_DISTANCE if it was new then: standing on cells
 the memory had seen free; someone walking to and fro stays a mover). It is
 **held** out of the occupancy memory while it moves, and while its cluster is new
 and stands mostly on cells the memory has seen free (something new where there
-was nothing: held NEW_OBJECT_SCANS scans, then written if it did not move).
+was nothing: held NEW_OBJECT_TIME, then written if it did not move).
 Held points are still obstacles for the local layer; a person walking by leaves
 no trail of "wall".
 """
@@ -39,6 +39,7 @@ from numpy.typing import NDArray
 from scipy.optimize import linear_sum_assignment
 
 from .occupancy import ESTABLISHED
+from .scan import scans_in
 
 #: Process noise density of the constant-velocity model [m^2/s^3].
 ACCEL_NOISE = 0.5
@@ -56,12 +57,14 @@ INITIAL_SPEED_SIGMA = 1.0
 #: (static clutter through a realistic lidar). A new track's uncertain velocity still
 #: lets it follow a walker.
 GATE_CHI2 = 5.99
-#: Scans a track may go unseen before it is dropped.
-MAX_MISSES = 3
+#: How long a track may go unseen before it is dropped [s] (3 scans at 5 Hz). What
+#: the tracker waits for is in seconds, counted in scans at the planning rate
+#: (core/scan.scans_in): a 20 Hz robot waits as long, over four times the scans.
+MAX_UNSEEN = 0.6
 #: Scans before a track's speed says whether it moves.
 MIN_HITS = 3
-#: A new object in seen-free space is held out of the memory this many scans.
-NEW_OBJECT_SCANS = 15
+#: A new object in seen-free space is held out of the memory this long [s].
+NEW_OBJECT_TIME = 3.0
 #: A track moves only once it is this far from where it was first seen [m]: the centroid
 #: of a static object's visible side wanders less as the robot drives past it.
 MOVE_DISTANCE = 0.3
@@ -82,9 +85,9 @@ THIN_LENGTH = 0.25
 MIN_POINTS = 3
 #: Clusters considered per scan at most (the largest first; a bound on the cycle).
 MAX_CLUSTERS = 40
-#: Scans whose held points are cleared from the memory (a mover found late: up to
-#: MOVE_DISTANCE at 0.15 m/s).
-TRAIL_SCANS = 12
+#: The held points of this long are cleared from the memory [s] (a mover found late:
+#: up to MOVE_DISTANCE at 0.15 m/s).
+TRAIL_TIME = 2.4
 #: Log odds below which a cell counts as seen free (two misses).
 FREE_LOG_ODDS = -0.5
 #: Fraction of a cluster's points on seen-free cells that makes it new.
@@ -100,12 +103,12 @@ WALL_LOG_ODDS = ESTABLISHED
 WALL_FRACTION = 0.5
 
 
-#: A cluster with this fraction of its points on obstacles that have stood STANDING_SCANS
-#: scans or more (2 s at the LDS-01's 5 Hz; NavigationMemory.standing) stands where
+#: A cluster with this fraction of its points on obstacles that have stood STANDING_TIME
+#: [s] or more (NavigationMemory.standing) stands where
 #: something has stood for a while: it is not moving, whatever its centroid does. A walker
 #: leaves such cells within a few scans; a person who stood there and walks off, too.
 HELD_UP_FRACTION = 0.5
-STANDING_SCANS = 10
+STANDING_TIME = 2.0
 
 
 @dataclass(frozen=True)
@@ -199,8 +202,14 @@ class Tracker:
     PER_TRACK = ('x', 'P', 'hits', 'misses', 'new_age', 'radius', 'ids', 'first', 'went',
                  'moved')
 
-    def __init__(self, gap: float, max_size: float, gate: float, moving_speed: float) -> None:
+    def __init__(self, gap: float, max_size: float, gate: float, moving_speed: float,
+                 period: float = 0.2) -> None:
+        """``period``: the time between two scans [s] (the planning period); the waits
+        (MAX_UNSEEN, NEW_OBJECT_TIME, TRAIL_TIME) are counted in scans of it."""
         self.gap, self.max_size, self.gate, self.moving_speed = gap, max_size, gate, moving_speed
+        self.max_misses = scans_in(MAX_UNSEEN, period)
+        self.new_object_scans = scans_in(NEW_OBJECT_TIME, period)
+        self.trail_scans = scans_in(TRAIL_TIME, period)
         self.reset()
 
     def reset(self) -> None:
@@ -216,7 +225,7 @@ class Tracker:
         self.went = np.zeros(0)          # the farthest it has been from there [m]
         self.moved = np.zeros(0, bool)   # whether it moved at the last scan it was seen
         self._next_id = 0
-        #: (track ids, points) of the last TRAIL_SCANS scans
+        #: (track ids, points) of the last trail_scans scans
         self._history: list[tuple[NDArray[np.int64], NDArray[np.float64]]] = []
         self.time: float | None = None
         self._last: Tracks | None = None
@@ -267,7 +276,7 @@ class Tracker:
                after: NDArray[np.float64] | None = None) -> Tracks:
         """Take a scan's obstacle points (n, 2) at time ``t`` [s] with the memory's log
         odds at each (n,; 0 off the map), whether each is on an obstacle that has stood
-        STANDING_SCANS scans (n,; none when not given) and how long after ``t`` each was
+        STANDING_TIME (n,; none when not given) and how long after ``t`` each was
         taken (n, [s]; a spinning lidar's beam i is i * time_increment after the first:
         a walker seen late in the sweep is measured where it was then; none: all at
         ``t``), before the scan is written; returns the tracks, at time ``t``.
@@ -328,7 +337,7 @@ class Tracker:
                          radius=np.zeros(m), ids=self._next_id + np.arange(m),
                          first=cents[fresh], went=np.zeros(m), moved=np.zeros(m, bool))
             self._next_id += m
-        keep = self.misses <= MAX_MISSES
+        keep = self.misses <= self.max_misses
         remap = np.cumsum(keep) - 1
         self._keep(keep)
         if remap.size:
@@ -351,14 +360,15 @@ class Tracker:
         moving = (self.hits >= MIN_HITS) & (speed >= self.moving_speed) \
             & (self.went >= went) & free
         self.moved = moving.copy()
-        held = moving | ((self.new_age >= 0) & (self.new_age < NEW_OBJECT_SCANS))
+        held = moving | ((self.new_age >= 0) & (self.new_age < self.new_object_scans))
         point_track = track_of[labels] if count else np.zeros(0, np.int64)
         # held[id] by track id; the last slot (id -1: a point of no track) stays False
         held_by_id = np.zeros(self._next_id + 1, bool)
         held_by_id[self.ids[held]] = True
         trail = [pts[held_by_id[ids]] for ids, pts in self._history] if np.any(held) else []
-        self._history = (self._history + [(np.where(point_track >= 0, self.ids[
-            np.maximum(point_track, 0)] if len(self.ids) else -1, -1), points)])[-TRAIL_SCANS:]
+        ids = np.where(point_track >= 0, self.ids[np.maximum(point_track, 0)]
+                       if len(self.ids) else -1, -1)
+        self._history = (self._history + [(ids, points)])[-self.trail_scans:]
         self._last = Tracks(self.x[:, :2].copy(), self.x[:, 2:].copy(), self.radius.copy(),
                             moving, held, point_track,
                             np.vstack(trail) if trail else np.zeros((0, 2)))
