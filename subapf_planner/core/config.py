@@ -216,12 +216,12 @@ class PlannerConfig:
     range_noise_fraction: float = param(0.025, '... and as a fraction of the range farther '
                                         'out (LDS-01: +/-5 % from 0.5 to 3.5 m, 2 sigma)',
                                         '', 0.0, 1.0)
-    deskew_bearings: bool = param(False, "De-skewed scans keep each return's exact "
-                                  'direction (core/scan.py deskew) instead of moving it to '
-                                  "the nearest beam of the scan's grid, up to half a beam "
-                                  'off: the scan alignment follows real buildings better, '
-                                  'the tracker sees more ghosts in clutter '
-                                  '(docs/alignment.md)')
+    deskew_bearings: bool = param(False, "The obstacles' and the tracker's de-skewed scans "
+                                  "keep each return's exact direction (core/scan.py deskew) "
+                                  "instead of moving it to the nearest beam of the scan's "
+                                  'grid, up to half a beam off (the tracker sees more ghosts '
+                                  'in clutter); the memory and the scan alignment always '
+                                  'keep them (docs/alignment.md)')
     # --- moving obstacles (core/tracking.py, core/evasion.py) ------------------------
     track_moving: bool = param(True, 'Track moving obstacles from the scans (clusters, '
                                'constant-velocity Kalman filters): their points stay out of '

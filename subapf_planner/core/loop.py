@@ -298,16 +298,19 @@ class DecisionLoop:
     def _deskewed(self, scan: Scan) -> tuple[Scan, Scan, np.ndarray]:
         """The scan as if taken at its first beam's instant (core/scan.py deskew), its
         ranges' noise averaged along each surface (core/scan.py denoise, by the lidar's
-        range_noise_*): for the obstacles and the tracker, and for the memory and the
-        alignment, where returns at grazing incidence keep their ranges
+        range_noise_*): for the obstacles and the tracker, on the scan's grid of angles
+        (each return at its own direction with deskew_bearings), and for the memory and
+        the alignment, each return at its own direction (a return moved to the grid's
+        beam is up to half a beam off, by an amount that changes along the sweep: each
+        turn would bend the map) and at grazing incidence keeping its range
         (GRAZING_MEMORY); and the odometry pose at that instant, interpolated
         (pose_between); once per scan."""
         if self._deskew is None or self._deskew[0] is not scan:
             cfg = self.cfg
             start = self.pose_between(scan.stamp)
             motion = self.sweep_motion(scan, start)
-            straight = deskew(scan, motion, cfg.laser_mount, cfg.deskew_bearings)
             exact = deskew(scan, motion, cfg.laser_mount, True)
+            straight = exact if cfg.deskew_bearings else deskew(scan, motion, cfg.laser_mount)
             obstacles, = denoise_each(straight, cfg.range_noise_floor,
                                       cfg.range_noise_fraction, (GRAZING_OBSTACLES,))
             memory, = denoise_each(exact, cfg.range_noise_floor, cfg.range_noise_fraction,
