@@ -21,6 +21,13 @@ as Hector SLAM's, with point-to-line residuals as in ICP), where
   on (:func:`_ends`: unknown, not seen-free, beyond; their nearest wall point
   would pull the pose back along the wall) or off the wall along it
   (:func:`_beside`);
+* each return weighed by its range's noise and by the squared cosine of its
+  incidence on the wall (the angle between its ray and the wall's normal there): an
+  occupancy grid draws a wall seen at grazing incidence where the rays that run along
+  it stop clearing its cells, a cell or more off, and a grazing return's distance to
+  the wall so drawn carries that error over the cosine (through the realistic lidar on
+  `building_042`, the grazing returns of a turn into a new corridor pulled the heading
+  one way, scan after scan, against those that met the walls square);
 * a prior towards the odometry prediction (PRIOR_SIGMA_XY, PRIOR_SIGMA_YAW per
   scan), so that a corridor, which fixes the pose across it but not along it,
   keeps odometry's estimate along it;
@@ -302,14 +309,16 @@ def _taking_part(field: DistanceField, world: NDArray[np.float64],
 
 def align(base_points: NDArray[np.float64], predicted: NDArray[np.float64],
           field: DistanceField | None, pieces: NDArray[np.int64] | None = None,
-          mover_size: float = math.inf, noise: tuple[float, float] = (0.0, 0.0)) -> Match:
+          mover_size: float = math.inf, noise: tuple[float, float] = (0.0, 0.0),
+          origin: tuple[float, float] = (0.0, 0.0)) -> Match:
     """The pose of base_footprint that puts ``base_points`` (n, 2; the returns in
     base_footprint [m]) on the field's walls, starting from and drawn towards
     ``predicted`` (x, y, yaw); see the module docstring. With ``pieces`` (each point's
     cluster label, n), a match is accepted only when its matched returns make MIN_PIECES
     landmarks (:func:`landmarks`; ``mover_size`` [m] the longest a mover can be), and
     the returns of pieces no longer than that match only walls that have stood
-    MIN_WALL_AGE (DistanceField.lookup)."""
+    MIN_WALL_AGE (DistanceField.lookup). ``origin``: the laser's position (x, y) in
+    base_footprint [m], where the rays start (each return's incidence on its wall)."""
     prior = np.asarray(predicted, float).copy()
     if field is None or len(base_points) < MIN_MATCHED:
         return Match(prior, False, 0, math.nan)
@@ -322,6 +331,8 @@ def align(base_points: NDArray[np.float64], predicted: NDArray[np.float64],
     sigma = np.hypot(RETURN_SIGMA, range_sigma(np.hypot(*base_points.T), *noise))
     weight_all = sigma ** -2
     reach = np.maximum(MAX_CORRESPONDENCE, 2.0 * sigma)
+    rays = base_points - np.asarray(origin, float)
+    rays /= np.maximum(np.hypot(*rays.T), 1e-9)[:, None]   # in base_footprint
     for _ in range(ITERATIONS):
         world = to_parent(pose, base_points)
         near, normal, d, use = _taking_part(field, world, small, reach)
@@ -335,7 +346,9 @@ def align(base_points: NDArray[np.float64], predicted: NDArray[np.float64],
         jac = np.column_stack((n[:, 0], n[:, 1], np.einsum('ij,ij->i', n, dyaw)))
         off = pose - prior
         off[2] = math.remainder(off[2], 2 * math.pi)
-        w_ret = weight_all[use]
+        # and by its incidence: the wall's normal in base_footprint against its ray
+        n_base = np.column_stack((c * n[:, 0] + s * n[:, 1], -s * n[:, 0] + c * n[:, 1]))
+        w_ret = weight_all[use] * np.einsum('ij,ij->i', n_base, rays[use]) ** 2
         h = (jac.T * w_ret) @ jac + INFO_PRIOR
         b = (jac.T * w_ret) @ res + INFO_PRIOR @ off
         step = -np.linalg.solve(h, b)

@@ -293,7 +293,8 @@ class NavigationMemory:
             self._distance_age = 0
         self._distance_age += 1
         return align(base, pred, self._distance, pieces, self.cfg.max_mover_size,
-                     (self.cfg.range_noise_floor, self.cfg.range_noise_fraction))
+                     (self.cfg.range_noise_floor, self.cfg.range_noise_fraction),
+                     self.cfg.laser_mount[:2])
 
     def avoid(self, point: ArrayLike, radius: float, until: float) -> None:
         """Block the cells within ``radius`` [m] of ``point`` in the navigation field
