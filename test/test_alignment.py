@@ -104,6 +104,25 @@ def test_a_corridor_is_corrected_across_and_left_alone_along():
 
 
 @pytest.mark.core
+@pytest.mark.parametrize('seed', [0, 1, 2])
+def test_a_wall_drawn_off_where_it_was_seen_grazing_does_not_turn_the_heading(seed):
+    """A corridor whose left wall the memory drew 5 cm out at its far end (a grid draws
+    a wall seen at grazing incidence a cell or more off), its end wall square ahead:
+    from the true pose the match keeps the heading within 4 mrad, the returns weighed
+    by their incidence on the walls (unweighed, the far grazing returns turned it by
+    8 mrad, and the drift bound let such turns through scan after scan)."""
+    def corridor(left_end_y):
+        return np.vstack([segment((-1.0, 0.375), (3.0, left_end_y)),
+                          segment((-1.0, -0.375), (3.0, -0.375)),
+                          segment((3.025, -0.375), (3.025, 0.375))])
+    true = np.array([0.0, 0.0, 0.0])
+    base = seen_from(corridor(0.375), true, seed=seed)
+    m = match(grid_with(corridor(0.425)), base, true)
+    assert m.accepted
+    assert abs(m.pose[2]) < 0.004 and np.hypot(*m.pose[:2]) < 0.003
+
+
+@pytest.mark.core
 def test_no_map_few_returns_or_a_jump_are_refused():
     walls = room()
     true = np.array([0.4, -0.3, 0.2])
