@@ -143,3 +143,13 @@ def test_flags_of_the_grid_s_beams_follow_each_return_to_its_own_direction(shift
     assert np.array_equal(np.flatnonzero(got),
                           np.sort(np.mod(np.array([10, 11, 12, 0]) - moved, n)))
     assert _on_grid(flags, grid, grid) is flags      # both on the grid: as they are
+
+
+@pytest.mark.parametrize('seconds, period, scans', [(2.0, 0.2, 10), (2.0, 0.05, 40),
+                                                     (5.0, 0.05, 100), (0.01, 0.2, 1)])
+def test_a_wait_in_seconds_is_as_many_scans_as_the_planning_rate_takes(seconds, period, scans):
+    """What the memory waits for (a cluster on what has stood STANDING_TIME, walls that
+    have stood MIN_WALL_AGE for small pieces of the scan) is a time: counted in scans
+    at the planning rate, at least one."""
+    from subapf_planner.core.scan import scans_in
+    assert scans_in(seconds, period) == scans

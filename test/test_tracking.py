@@ -74,32 +74,6 @@ def test_a_cluster_seen_late_in_the_sweep_is_placed_at_the_scan_s_time(late):
     assert np.hypot(*(b.position[0] - truth)) == pytest.approx(late, abs=0.03)
 
 
-@pytest.mark.parametrize('hz', [5.0, 20.0])
-def test_what_the_tracker_waits_for_is_seconds_at_any_rate(hz):
-    """A chair put where the memory saw free space is held out of the memory for
-    NEW_OBJECT_TIME, and a track hidden for less than MAX_UNSEEN keeps its id, at 5 Hz
-    and at 20 Hz alike (the scans counted at the rate, not a fixed number of them)."""
-    from subapf_planner.core.tracking import MAX_UNSEEN, NEW_OBJECT_TIME
-    period = 1.0 / hz
-    tr = Tracker(0.15, 1.2, 0.6, 0.04, period)
-    chair = disc_points((2.0, 0.5), 0.2)
-    free = np.full(len(chair), -2.0)          # where the memory saw free space
-    held_for = 0.0
-    for k in range(round(2.0 * NEW_OBJECT_TIME / period)):
-        tracks = tr.update(chair, k * period, free)
-        assert len(tracks.position) == 1 and not tracks.moving[0]
-        if tracks.held[0]:
-            held_for = (k + 1) * period
-    assert held_for == pytest.approx(NEW_OBJECT_TIME, abs=1e-9)
-    ident = tr.ids[0]
-    t = 2.0 * NEW_OBJECT_TIME
-    hidden = round(0.7 * MAX_UNSEEN / period)   # occluded a while: no returns of it
-    for k in range(hidden):
-        tr.update(np.zeros((0, 2)), t + k * period, np.zeros(0))
-    tr.update(chair, t + hidden * period, free)
-    assert list(tr.ids) == [ident]
-
-
 def test_a_standing_object_and_a_wall_do_not_move():
     tr = Tracker(0.15, 1.2, 0.6, 0.04)
     rng = np.random.default_rng(1)

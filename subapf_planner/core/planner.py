@@ -114,9 +114,8 @@ def plan(cfg: PlannerConfig, pose: ArrayLike, goal: ArrayLike, obstacles: ArrayL
     return Pipeline(cfg, None).proposer.run(cycle).result
 
 
-def _tracker_settings(cfg: PlannerConfig) -> tuple[float, float, float, float, float]:
-    return (cfg.cluster_gap, cfg.max_mover_size, cfg.track_gate, cfg.moving_speed,
-            cfg.period)
+def _tracker_settings(cfg: PlannerConfig) -> tuple[float, float, float, float]:
+    return (cfg.cluster_gap, cfg.max_mover_size, cfg.track_gate, cfg.moving_speed)
 
 
 def _tracker(cfg: PlannerConfig) -> Tracker:

@@ -10,7 +10,7 @@ tracked. The others are
 associated with the tracks predicted to this scan's time (Hungarian assignment,
 scipy, within ``track_gate`` and the prediction's uncertainty: GATE_CHI2) and update
 their filter; unmatched clusters start
-tentative tracks, and a track unseen for MAX_UNSEEN seconds is dropped.
+tentative tracks, and a track unseen for MAX_MISSES scans is dropped.
 
 The filter (per track, vectorised over all tracks) is the constant-velocity
 model: state (x, y, vx, vy) [m, m/s], white-acceleration process noise of
@@ -25,7 +25,13 @@ first seen at some time (NEW_MOVE_DISTANCE if it was new then: standing on cells
 the memory had seen free; someone walking to and fro stays a mover). It is
 **held** out of the occupancy memory while it moves, and while its cluster is new
 and stands mostly on cells the memory has seen free (something new where there
-was nothing: held NEW_OBJECT_TIME, then written if it did not move).
+was nothing: held NEW_OBJECT_SCANS scans, then written if it did not move).
+
+What the tracker waits for is counted in scans, the evidence it has, at any rate;
+what the memory waits for (STANDING_TIME, alignment.MIN_WALL_AGE) is a time. Counted
+in seconds at the Jackal's 20 Hz (four times the burger's scans), the tracker kept
+unseen tracks and held new objects so long that posts of the BARN worlds, hidden
+behind each other and seen again, seemed to move (docs/robots.md).
 Held points are still obstacles for the local layer; a person walking by leaves
 no trail of "wall".
 """
@@ -39,7 +45,6 @@ from numpy.typing import NDArray
 from scipy.optimize import linear_sum_assignment
 
 from .occupancy import ESTABLISHED
-from .scan import scans_in
 
 #: Process noise density of the constant-velocity model [m^2/s^3].
 ACCEL_NOISE = 0.5
@@ -57,14 +62,12 @@ INITIAL_SPEED_SIGMA = 1.0
 #: (static clutter through a realistic lidar). A new track's uncertain velocity still
 #: lets it follow a walker.
 GATE_CHI2 = 5.99
-#: How long a track may go unseen before it is dropped [s] (3 scans at 5 Hz). What
-#: the tracker waits for is in seconds, counted in scans at the planning rate
-#: (core/scan.scans_in): a 20 Hz robot waits as long, over four times the scans.
-MAX_UNSEEN = 0.6
+#: Scans a track may go unseen before it is dropped.
+MAX_MISSES = 3
 #: Scans before a track's speed says whether it moves.
 MIN_HITS = 3
-#: A new object in seen-free space is held out of the memory this long [s].
-NEW_OBJECT_TIME = 3.0
+#: A new object in seen-free space is held out of the memory this many scans.
+NEW_OBJECT_SCANS = 15
 #: A track moves only once it is this far from where it was first seen [m]: the centroid
 #: of a static object's visible side wanders less as the robot drives past it.
 MOVE_DISTANCE = 0.3
@@ -85,9 +88,9 @@ THIN_LENGTH = 0.25
 MIN_POINTS = 3
 #: Clusters considered per scan at most (the largest first; a bound on the cycle).
 MAX_CLUSTERS = 40
-#: The held points of this long are cleared from the memory [s] (a mover found late:
-#: up to MOVE_DISTANCE at 0.15 m/s).
-TRAIL_TIME = 2.4
+#: Scans whose held points are cleared from the memory (a mover found late: up to
+#: MOVE_DISTANCE at 0.15 m/s).
+TRAIL_SCANS = 12
 #: Log odds below which a cell counts as seen free (two misses).
 FREE_LOG_ODDS = -0.5
 #: Fraction of a cluster's points on seen-free cells that makes it new.
@@ -202,14 +205,8 @@ class Tracker:
     PER_TRACK = ('x', 'P', 'hits', 'misses', 'new_age', 'radius', 'ids', 'first', 'went',
                  'moved')
 
-    def __init__(self, gap: float, max_size: float, gate: float, moving_speed: float,
-                 period: float = 0.2) -> None:
-        """``period``: the time between two scans [s] (the planning period); the waits
-        (MAX_UNSEEN, NEW_OBJECT_TIME, TRAIL_TIME) are counted in scans of it."""
+    def __init__(self, gap: float, max_size: float, gate: float, moving_speed: float) -> None:
         self.gap, self.max_size, self.gate, self.moving_speed = gap, max_size, gate, moving_speed
-        self.max_misses = scans_in(MAX_UNSEEN, period)
-        self.new_object_scans = scans_in(NEW_OBJECT_TIME, period)
-        self.trail_scans = scans_in(TRAIL_TIME, period)
         self.reset()
 
     def reset(self) -> None:
@@ -225,7 +222,7 @@ class Tracker:
         self.went = np.zeros(0)          # the farthest it has been from there [m]
         self.moved = np.zeros(0, bool)   # whether it moved at the last scan it was seen
         self._next_id = 0
-        #: (track ids, points) of the last trail_scans scans
+        #: (track ids, points) of the last TRAIL_SCANS scans
         self._history: list[tuple[NDArray[np.int64], NDArray[np.float64]]] = []
         self.time: float | None = None
         self._last: Tracks | None = None
@@ -337,7 +334,7 @@ class Tracker:
                          radius=np.zeros(m), ids=self._next_id + np.arange(m),
                          first=cents[fresh], went=np.zeros(m), moved=np.zeros(m, bool))
             self._next_id += m
-        keep = self.misses <= self.max_misses
+        keep = self.misses <= MAX_MISSES
         remap = np.cumsum(keep) - 1
         self._keep(keep)
         if remap.size:
@@ -360,7 +357,7 @@ class Tracker:
         moving = (self.hits >= MIN_HITS) & (speed >= self.moving_speed) \
             & (self.went >= went) & free
         self.moved = moving.copy()
-        held = moving | ((self.new_age >= 0) & (self.new_age < self.new_object_scans))
+        held = moving | ((self.new_age >= 0) & (self.new_age < NEW_OBJECT_SCANS))
         point_track = track_of[labels] if count else np.zeros(0, np.int64)
         # held[id] by track id; the last slot (id -1: a point of no track) stays False
         held_by_id = np.zeros(self._next_id + 1, bool)
@@ -368,7 +365,7 @@ class Tracker:
         trail = [pts[held_by_id[ids]] for ids, pts in self._history] if np.any(held) else []
         ids = np.where(point_track >= 0, self.ids[np.maximum(point_track, 0)]
                        if len(self.ids) else -1, -1)
-        self._history = (self._history + [(ids, points)])[-self.trail_scans:]
+        self._history = (self._history + [(ids, points)])[-TRAIL_SCANS:]
         self._last = Tracks(self.x[:, :2].copy(), self.x[:, 2:].copy(), self.radius.copy(),
                             moving, held, point_track,
                             np.vstack(trail) if trail else np.zeros((0, 2)))
