@@ -89,8 +89,8 @@ class Scan:
 
 def scans_in(seconds: float, period: float) -> int:
     """How many scans make ``seconds`` [s] when one is taken each ``period`` [s] (the
-    planner takes one a planning cycle; at least one). What the memory and the tracker
-    wait for is a time: the same seconds at 5 Hz and at 20 Hz."""
+    planner takes one a planning cycle; at least one). What the memory waits for is a
+    time: the same seconds at 5 Hz and at 20 Hz."""
     return max(1, round(seconds / period))
 
 

@@ -26,14 +26,14 @@ the memory had seen free; someone walking to and fro stays a mover). It is
 **held** out of the occupancy memory while it moves, and while its cluster is new
 and stands mostly on cells the memory has seen free (something new where there
 was nothing: held NEW_OBJECT_SCANS scans, then written if it did not move).
+Held points are still obstacles for the local layer; a person walking by leaves
+no trail of "wall".
 
 What the tracker waits for is counted in scans, the evidence it has, at any rate;
 what the memory waits for (STANDING_TIME, alignment.MIN_WALL_AGE) is a time. Counted
 in seconds at the Jackal's 20 Hz (four times the burger's scans), the tracker kept
 unseen tracks and held new objects so long that posts of the BARN worlds, hidden
 behind each other and seen again, seemed to move (docs/robots.md).
-Held points are still obstacles for the local layer; a person walking by leaves
-no trail of "wall".
 """
 
 from __future__ import annotations
@@ -363,9 +363,8 @@ class Tracker:
         held_by_id = np.zeros(self._next_id + 1, bool)
         held_by_id[self.ids[held]] = True
         trail = [pts[held_by_id[ids]] for ids, pts in self._history] if np.any(held) else []
-        ids = np.where(point_track >= 0, self.ids[np.maximum(point_track, 0)]
-                       if len(self.ids) else -1, -1)
-        self._history = (self._history + [(ids, points)])[-TRAIL_SCANS:]
+        self._history = (self._history + [(np.where(point_track >= 0, self.ids[
+            np.maximum(point_track, 0)] if len(self.ids) else -1, -1), points)])[-TRAIL_SCANS:]
         self._last = Tracks(self.x[:, :2].copy(), self.x[:, 2:].copy(), self.radius.copy(),
                             moving, held, point_track,
                             np.vstack(trail) if trail else np.zeros((0, 2)))
