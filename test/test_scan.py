@@ -132,17 +132,17 @@ def test_flags_of_the_grid_s_beams_follow_each_return_to_its_own_direction(shift
     """The tracker flags beams of the scan on its grid of angles; the memory takes the
     same sweep with each return at its own direction: each return takes the flag of the
     grid's beam its direction is nearest (a turn around the full circle wraps)."""
-    from subapf_planner.core.planner import _on_grid
+    from subapf_planner.core.scan import on_grid
     n, inc = 360, math.radians(1.0)
     grid = Scan(np.full(n, 2.0), 0.0, inc, 0.12, 3.5)
     exact = Scan(np.full(n, 2.0), 0.0, inc, 0.12, 3.5,
                  bearings=(np.arange(n) + shift) * inc)
     flags = np.zeros(n, bool)
     flags[[10, 11, 12, 0]] = True
-    got = _on_grid(flags, grid, exact)
+    got = on_grid(flags, grid, exact)
     assert np.array_equal(np.flatnonzero(got),
                           np.sort(np.mod(np.array([10, 11, 12, 0]) - moved, n)))
-    assert _on_grid(flags, grid, grid) is flags      # both on the grid: as they are
+    assert on_grid(flags, grid, grid) is flags      # both on the grid: as they are
 
 
 @pytest.mark.parametrize('seconds, period, scans', [(2.0, 0.2, 10), (2.0, 0.05, 40),

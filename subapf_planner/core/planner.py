@@ -50,7 +50,7 @@ from .pipeline import Pipeline
 from .proposers import local_radius
 from .robot import compose, invert, to_parent
 from .sampling import clearance
-from .scan import Scan, ScanError, range_sigma, scan_to_points, scans_in
+from .scan import Scan, ScanError, on_grid, range_sigma, scan_to_points, scans_in
 from .status import Status
 from .tracking import NO_TRACKS, STANDING_TIME, Tracker, Tracks
 
@@ -128,24 +128,6 @@ def _near(points: NDArray, centres: NDArray, radii: NDArray) -> NDArray[np.bool_
         return np.zeros(len(points), bool)
     d = np.hypot(*(points[:, None, :] - centres[None, :, :]).transpose(2, 0, 1))
     return np.any(d <= radii + MOVER_MARGIN, axis=1)
-
-
-def _on_grid(flags: NDArray[np.bool_] | None, grid: Scan, exact: Scan
-             ) -> NDArray[np.bool_] | None:
-    """Per-beam ``flags`` of a scan on its grid of angles (``grid``), for the returns of
-    the same sweep kept at their own bearings (``exact``: each return of its beam, at its
-    direction; core/scan.py deskew): each return takes the flag of the grid's beam its
-    direction is nearest (the beam it landed in there). Unchanged when both scans are on
-    the grid or both keep their bearings."""
-    if flags is None or exact.bearings is None or grid.bearings is not None or not len(flags):
-        return flags
-    n = len(flags)
-    with np.errstate(invalid='ignore'):
-        k = np.rint((exact.bearings - grid.angle_min) / grid.angle_increment)
-    k = np.where(np.isfinite(k), k, 0).astype(np.int64)
-    full = n * abs(grid.angle_increment) >= 2.0 * math.pi - 0.5 * abs(grid.angle_increment)
-    k = np.mod(k, n) if full else np.clip(k, 0, n - 1)
-    return flags[k]
 
 
 class Planner:
@@ -260,7 +242,7 @@ class Planner:
                 seen = memory_scan
                 seen_base = scan_to_points(seen, (0.0, 0.0, 0.0), cfg.laser_mount,
                                            cfg.obstacle_range)
-                transient = _on_grid(transient, scan, seen)
+                transient = on_grid(transient, scan, seen)
             self._perception = Perception(seen, seen_base, odom_scan_pose, goal, transient,
                                           tracks.trail)
         obstacles = points

@@ -94,6 +94,29 @@ def scans_in(seconds: float, period: float) -> int:
     return max(1, round(seconds / period))
 
 
+def full_turn(n: int, angle_increment: float) -> bool:
+    """Whether ``n`` beams ``angle_increment`` [rad] apart go round the whole circle (the
+    last beam next to the first)."""
+    return n * abs(angle_increment) >= 2.0 * math.pi - 0.5 * abs(angle_increment)
+
+
+def on_grid(flags: NDArray[np.bool_] | None, grid: Scan, exact: Scan
+            ) -> NDArray[np.bool_] | None:
+    """Per-beam ``flags`` of a scan on its grid of angles (``grid``), for the returns of
+    the same sweep kept at their own bearings (``exact``: each return of its beam, at its
+    direction; :func:`deskew`): each return takes the flag of the grid's beam its
+    direction is nearest (the beam it landed in there). Unchanged when both scans are on
+    the grid or both keep their bearings."""
+    if flags is None or exact.bearings is None or grid.bearings is not None or not len(flags):
+        return flags
+    n = len(flags)
+    with np.errstate(invalid='ignore'):
+        k = np.rint((exact.bearings - grid.angle_min) / grid.angle_increment)
+    k = np.where(np.isfinite(k), k, 0).astype(np.int64)
+    k = np.mod(k, n) if full_turn(n, grid.angle_increment) else np.clip(k, 0, n - 1)
+    return flags[k]
+
+
 def beam_angles(n: int, angle_min: float, angle_increment: float) -> NDArray[np.float64]:
     """Angle of each beam in the laser frame [rad]."""
     return angle_min + angle_increment * np.arange(n)
@@ -177,7 +200,7 @@ def deskew(scan: Scan, motion: ArrayLike, mount: ArrayLike = (0.0, 0.0, 0.0),
     inc = scan.angle_increment
     bins = np.rint(np.mod(np.arctan2(ey, ex) - scan.angle_min, 2.0 * math.pi) / inc
                    ).astype(np.int64)
-    if n * inc >= 2.0 * math.pi - 0.5 * inc:
+    if full_turn(n, inc):
         bins %= n                       # a full turn: the last bin is next to the first
     keep = bins < n
     dist = np.hypot(ex, ey)[keep]
@@ -243,7 +266,7 @@ def denoise_each(scan: Scan, floor: float, fraction: float, grazing: Sequence[fl
     ux, uy = np.cos(a), np.sin(a)
     x, y = rr * ux, rr * uy
     sigma = range_sigma(rr, floor, fraction)
-    full = n * scan.angle_increment >= 2.0 * math.pi - 0.5 * scan.angle_increment
+    full = full_turn(n, scan.angle_increment)
     count = hit.astype(float)
     sx, sy, sxx, syy, sxy = x * count, y * count, x * x * count, y * y * count, x * y * count
     for k in range(1, half_window + 1):
