@@ -11,6 +11,7 @@ import pytest
 from subapf_planner.core.alignment import (
     DRIFT_XY_PER_M,
     DRIFT_YAW_PER_M,
+    LOCALISE_MAX_XY,
     MAX_STEP_XY,
     MIN_MATCHED,
     MIN_WALL_AGE,
@@ -18,9 +19,11 @@ from subapf_planner.core.alignment import (
     align,
     distance_field,
     landmarks,
+    localise,
     within_drift,
 )
 from subapf_planner.core.config import PlannerConfig
+from subapf_planner.core.known_map import KnownMap
 from subapf_planner.core.occupancy import ESTABLISHED, NOT_ESTABLISHED, OccupancyGrid
 from subapf_planner.core.planner import Planner
 from subapf_planner.core.robot import to_parent
@@ -86,6 +89,59 @@ def test_a_known_offset_is_recovered():
     assert m.accepted and m.matched > 200 and m.rms < 0.03
     assert np.hypot(*(m.pose[:2] - true[:2])) < 0.008
     assert abs(m.pose[2] - true[2]) < math.radians(0.1)
+
+
+def thick_room() -> KnownMap:
+    """room() as a map_server map (free 0, walls 100) draws it: each wall three cells
+    thick, its face where the laser sees it and the rest behind; in the map's frame."""
+    xs = np.arange(-4.0, 4.0, RES) + RES / 2
+    ys = np.arange(-3.0, 3.0, RES) + RES / 2
+    x, y = np.meshgrid(xs, ys)
+    x0, x1, y0, y1 = -2.975, 3.025, -1.975, 2.025   # room()'s walls: the faces' cells
+    inside = (x > x0 + 0.01) & (x < x1 - 0.01) & (y > y0 + 0.01) & (y < y1 - 0.01)
+    band = (x > x0 - 0.11) & (x < x1 + 0.11) & (y > y0 - 0.11) & (y < y1 + 0.11)
+    pillar = np.hypot(x - 1.0, y - 0.5) < 0.31
+    return KnownMap(np.where(band & ~inside | pillar, 100, 0).astype(np.int8),
+                    (-4.0, -3.0), RES)
+
+
+@pytest.mark.core
+def test_a_known_maps_thick_wall_is_matched_at_its_face():
+    """A map draws a wall three cells thick; a return inside it is as far from the wall as
+    from its face, not matched to the cell it fell in (the scans' own walls, hit by
+    returns, are matched where the returns fell)."""
+    g = OccupancyGrid(RES, 20.0, hit_places=True)
+    g.know(thick_room())
+    inside = np.array([[-3.025, 0.325]])   # in the left wall (face at -2.95), a cell deep
+    face = distance_field(g.log_odds, g.origin, RES, inside, 0.4, g.hit_offset,
+                          hit_count=g.hit_count)
+    assert face.lookup(inside)[2][0] == pytest.approx(0.05, abs=0.01)
+    whole = distance_field(g.log_odds, g.origin, RES, inside, 0.4, g.hit_offset)
+    assert whole.lookup(inside)[2][0] < 0.01
+
+
+@pytest.mark.core
+@pytest.mark.parametrize('off', [(0.12, -0.08, 0.05), (-0.2, 0.1, -0.08)])
+def test_a_localisers_decimetres_are_taken_out_on_its_map(off):
+    """On a map the robot already has, a localiser's error (decimetres, degrees) is not a
+    wheel's millimetres: the scan alignment refuses such a step, localise takes it (to
+    within 1.5 cm and 0.3 degrees), and refuses one beyond LOCALISE_MAX_XY."""
+    walls = room()
+    g = OccupancyGrid(RES, 20.0, hit_places=True)
+    g.know(thick_room())
+    true = np.array([0.4, -0.3, 0.2])
+    base = seen_from(walls, true)
+    predicted = true + off
+    field = distance_field(g.log_odds, g.origin, RES, to_parent(predicted, base), 1.0,
+                           g.hit_offset, hit_count=g.hit_count)
+    assert not align(base, predicted, field).accepted
+    m = localise(base, predicted, field)
+    assert m.accepted
+    assert np.hypot(*(m.pose[:2] - true[:2])) < 0.015 and abs(m.pose[2] - true[2]) < 0.005
+    far = true + [LOCALISE_MAX_XY + 0.2, 0.0, 0.0]
+    m = localise(base, far, distance_field(g.log_odds, g.origin, RES, to_parent(far, base),
+                                           1.0, g.hit_offset, hit_count=g.hit_count))
+    assert not m.accepted and np.array_equal(m.pose, far)
 
 
 @pytest.mark.core
@@ -193,6 +249,27 @@ def test_the_planner_corrects_drift_while_it_drives_and_not_while_it_stands():
     assert c[0] == pytest.approx(0.02, abs=0.008) and abs(c[1]) < 0.008
     for _ in range(4):                                   # standing: nothing moves it
         assert np.array_equal(scan_at((1.04, 0.0, 0.005), (1.0, 0.0, 0.0)), c)
+
+
+@pytest.mark.core
+def test_started_from_a_localisers_map_the_first_scans_take_its_error_out():
+    """The planner started from a map and a localiser's map -> odom 0.1 m and 0.03 rad
+    off (Planner.start_from): standing still (where the wheels' drift bound lets nothing
+    through), the first scan's match in the localiser's basin brings the planned pose
+    to within 1.5 cm and 0.3 degrees of the truth, and the next scans keep it there."""
+    walls = room()
+    planner = Planner(PlannerConfig(scan_alignment=True, laser_x=0.0, laser_y=0.0,
+                                    laser_yaw=0.0))
+    planner.start_from(thick_room(), (0.1, 0.0, 0.03))
+    true = np.array([0.4, -0.3, 0.2])
+    odom = true   # odom truly is the map's frame; the localiser says otherwise
+    for k in range(1, 5):
+        planner.step(odom, (2.0, -1.0), Scan(ranges_from(walls, true), 0.0,
+                                             math.radians(1.0), 0.12, 3.5, 0.2 * k),
+                     now=0.2 * k)
+        planner.after_tick()
+        pose = planner.in_map(odom)
+        assert np.hypot(*(pose[:2] - true[:2])) < 0.015 and abs(pose[2] - true[2]) < 0.005
 
 
 @pytest.mark.sim

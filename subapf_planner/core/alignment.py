@@ -93,6 +93,9 @@ ITERATIONS = 6
 CONVERGED = 5e-4
 #: Blur of the wall mask whose structure gives the walls' normals [cells].
 NORMAL_SIGMA = 1.0
+#: A map's wall face is seen from one side when the free space about it lies this much
+#: more (its gradient's cosine with the normal) on that side (_free_side).
+FREE_SIDE = 0.5
 #: Prior standard deviation of the prediction, per scan [m], [rad].
 PRIOR_SIGMA_XY = 0.02
 PRIOR_SIGMA_YAW = 0.02
@@ -105,6 +108,20 @@ INFO_PRIOR.setflags(write=False)
 #: A match that moves the prediction more than this is refused [m], [rad].
 MAX_STEP_XY = 0.03
 MAX_STEP_YAW = 0.03
+#: A map the robot already has, started from a localiser's map -> odom (Planner.start_from),
+#: is first matched in a wider basin (:func:`localise`): the localiser's error is not a
+#: wheel's drift of millimetres. The passes' reach, coarse to fine [m] ...
+LOCALISE_REACH = (0.4, 0.2, 0.1)
+#: ... the localiser's uncertainty as that match's prior [m], [rad] ...
+LOCALISE_SIGMA_XY = 0.3
+LOCALISE_SIGMA_YAW = 0.1
+#: ... and the most it may move the pose (a bigger step is a wrong match) [m], [rad].
+LOCALISE_MAX_XY = 0.5
+LOCALISE_MAX_YAW = 0.2
+#: Scans are matched so until one such match is accepted, for this long at most after the
+#: map was taken [s] (then the wheels' bounds again: a map that does not fit is no
+#: localisation).
+LOCALISE_TIME = 2.0
 #: Drift the wheels can add, per metre driven and per radian turned, and so the most a
 #: match may move the prediction since the last scan [m/m], [m/rad], [rad/m], [rad/rad].
 DRIFT_XY_PER_M = 0.05
@@ -151,6 +168,15 @@ class DistanceField:
         d = np.hypot(*(points - near).T) + found[:, 4]
         return near, found[:, 2:4], d, found[:, 5] > 0.0
 
+    def free_side(self, points: NDArray[np.float64]) -> NDArray[np.float64]:
+        """Per point (n, 2): the free side of its nearest wall point's face, as a unit
+        normal, where only one side is free (a map's face: _free_side); zeros else."""
+        cells = np.floor((points - self.origin) / self.resolution).astype(np.int64)
+        h, w = self.shape
+        col, row = cells[:, 0], cells[:, 1]
+        inside = (col >= 0) & (row >= 0) & (col < w) & (row < h)
+        return self.table[self.index[np.where(inside, row * w + col, -1)], 6:8]
+
 
 def _ends(wall: NDArray[np.bool_], normal: NDArray[np.float64],
           seen_free: NDArray[np.bool_]) -> NDArray[np.bool_]:
@@ -189,11 +215,25 @@ def _normals(wall: NDArray[np.bool_]) -> NDArray[np.float64]:
     return np.stack((np.cos(angle), np.sin(angle)), axis=-1).astype(np.float64)
 
 
+def _free_side(free: NDArray[np.bool_], unhit: NDArray[np.bool_], rows: NDArray[np.int64],
+               cols: NDArray[np.int64], normal: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Per wall cell (``rows``, ``cols``, its unit ``normal`` (k, 2)): the normal turned to
+    the side seen free where only that side is and the cell is ``unhit`` (a map's face,
+    which the laser sees from that side only); zeros elsewhere (either side)."""
+    blurred = ndimage.gaussian_filter(free.astype(np.float32), NORMAL_SIGMA)
+    towards = np.column_stack((ndimage.sobel(blurred, axis=1)[rows, cols],
+                               ndimage.sobel(blurred, axis=0)[rows, cols]))
+    along = np.einsum('ij,ij->i', normal, towards)
+    one_sided = unhit & (np.abs(along) > FREE_SIDE * np.hypot(*towards.T) + 1e-6)
+    return np.where(one_sided[:, None], normal * np.sign(along)[:, None], 0.0)
+
+
 def distance_field(log_odds: NDArray[np.float32], origin: NDArray[np.float64],
                    resolution: float, around: NDArray[np.float64], reach: float,
                    hit_offset: NDArray[np.float32] | None = None,
                    established_at: NDArray[np.int32] | None = None,
-                   scans: int = 0, min_wall_scans: int = 0) -> DistanceField | None:
+                   scans: int = 0, min_wall_scans: int = 0,
+                   hit_count: NDArray[np.int16] | None = None) -> DistanceField | None:
     """The field of the established cells of a log-odds grid (corner of cell (0, 0) at
     ``origin``) within ``reach`` [m] of the box of the points ``around`` (n, 2); None
     when that window holds no established cell. ``hit_offset`` (the grid's, h x w x 2
@@ -201,7 +241,11 @@ def distance_field(log_odds: NDArray[np.float32], origin: NDArray[np.float64],
     centres would pull the pose by up to half a cell. ``established_at`` (the grid's,
     h x w: the scan from which each cell has been established) and ``scans`` (the
     grid's count now) tell how long each wall has stood: those established fewer than
-    ``min_wall_scans`` scans ago are young (DistanceField.lookup)."""
+    ``min_wall_scans`` scans ago are young (DistanceField.lookup). ``hit_count`` (the
+    grid's, h x w): a wall cell no return has hit (a known map's: core/known_map.py) is
+    one only where it faces space seen free, its face; a map draws a wall as thick as
+    its cells make it, and a return matched to the inside of one is as near to a wall
+    as one on its face."""
     lo_xy = around.min(axis=0) - reach
     hi_xy = around.max(axis=0) + reach
     n_rows, n_cols = log_odds.shape
@@ -211,6 +255,9 @@ def distance_field(log_odds: NDArray[np.float32], origin: NDArray[np.float64],
     if c0 >= c1 - 1 or r0 >= r1 - 1:
         return None
     wall = log_odds[r0:r1, c0:c1] >= ESTABLISHED
+    free = log_odds[r0:r1, c0:c1] < 0.0
+    if hit_count is not None:
+        wall &= (hit_count[r0:r1, c0:c1] > 0) | ndimage.binary_dilation(free)
     if not np.any(wall):
         return None
     rows, cols = ndimage.distance_transform_edt(~wall, return_distances=False,
@@ -226,10 +273,13 @@ def distance_field(log_odds: NDArray[np.float32], origin: NDArray[np.float64],
     new = np.zeros(wall_rows.size, bool) if established_at is None else \
         established_at[r0:r1, c0:c1][wall_rows, wall_cols].astype(np.int64) \
         > scans - min_wall_scans
-    end = _ends(wall, normals, log_odds[r0:r1, c0:c1] < 0.0)
-    table = np.zeros((wall_rows.size + 1, 6))
+    end = _ends(wall, normals, free)
+    table = np.zeros((wall_rows.size + 1, 8))
     table[:-1, 0:2], table[:-1, 2:4] = point, normals
     table[:-1, 4], table[:-1, 5] = np.where(end, np.inf, 0.0), new
+    if hit_count is not None:   # a map's face: which side of it is free
+        table[:-1, 6:8] = _free_side(free, hit_count[r0:r1, c0:c1][wall_rows, wall_cols] == 0,
+                                     wall_rows, wall_cols, normals)
     table[-1, 4] = np.inf   # off the window: no wall point, an end (no distance), not new
     return DistanceField(np.append(index[rows, cols].ravel(), np.int32(wall_rows.size)),
                          table, wall.shape, corner, resolution)
@@ -298,19 +348,28 @@ def landmarks(points: NDArray[np.float64], pieces: NDArray[np.int64],
 
 def _taking_part(field: DistanceField, world: NDArray[np.float64],
                  small: NDArray[np.bool_], reach: NDArray[np.float64] | float
-                 = MAX_CORRESPONDENCE) -> tuple[NDArray, NDArray, NDArray, NDArray]:
+                 = MAX_CORRESPONDENCE, eye: NDArray[np.float64] | None = None
+                 ) -> tuple[NDArray, NDArray, NDArray, NDArray]:
     """For the returns at ``world`` (n, 2) [m]: the nearest wall point, the normal, the
     distance (DistanceField.lookup) and which take part: beside a wall (:func:`_beside`),
-    and for those of ``small`` pieces, a wall that has stood (not young)."""
+    for those of ``small`` pieces a wall that has stood (not young), and with ``eye``
+    (the laser, x, y [m]) one of whose faces a map holds the free side (_free_side) only
+    if that side faces the laser (a return on the far face of a map's wall is one from
+    its near face, offset)."""
     near, normal, d, young = field.lookup(world)
     use = _beside(world, near, normal, d, field.resolution, reach) & ~(small & young)
+    if eye is not None:
+        side = field.free_side(world)
+        use &= np.einsum('ij,ij->i', side, eye - near) >= 0.0
     return near, normal, d, use
 
 
 def align(base_points: NDArray[np.float64], predicted: NDArray[np.float64],
           field: DistanceField | None, pieces: NDArray[np.int64] | None = None,
           mover_size: float = math.inf, noise: tuple[float, float] = (0.0, 0.0),
-          origin: tuple[float, float] = (0.0, 0.0)) -> Match:
+          origin: tuple[float, float] = (0.0, 0.0), *, reach: float = MAX_CORRESPONDENCE,
+          max_step: tuple[float, float] = (MAX_STEP_XY, MAX_STEP_YAW),
+          info_prior: NDArray[np.float64] = INFO_PRIOR) -> Match:
     """The pose of base_footprint that puts ``base_points`` (n, 2; the returns in
     base_footprint [m]) on the field's walls, starting from and drawn towards
     ``predicted`` (x, y, yaw); see the module docstring. With ``pieces`` (each point's
@@ -318,7 +377,10 @@ def align(base_points: NDArray[np.float64], predicted: NDArray[np.float64],
     landmarks (:func:`landmarks`; ``mover_size`` [m] the longest a mover can be), and
     the returns of pieces no longer than that match only walls that have stood
     MIN_WALL_AGE (DistanceField.lookup). ``origin``: the laser's position (x, y) in
-    base_footprint [m], where the rays start (each return's incidence on its wall)."""
+    base_footprint [m], where the rays start (each return's incidence on its wall).
+    ``reach`` [m] (at least twice a return's sigma), ``max_step`` [m, rad] and
+    ``info_prior`` (the prediction's information on x, y, yaw) are the default scan's
+    MAX_CORRESPONDENCE, MAX_STEP_* and INFO_PRIOR; :func:`localise` widens them."""
     prior = np.asarray(predicted, float).copy()
     if field is None or len(base_points) < MIN_MATCHED:
         return Match(prior, False, 0, math.nan)
@@ -330,12 +392,14 @@ def align(base_points: NDArray[np.float64], predicted: NDArray[np.float64],
     # return may lie farther from its wall
     sigma = np.hypot(RETURN_SIGMA, range_sigma(np.hypot(*base_points.T), *noise))
     weight_all = sigma ** -2
-    reach = np.maximum(MAX_CORRESPONDENCE, 2.0 * sigma)
+    reach = np.maximum(reach, 2.0 * sigma)
     rays = base_points - np.asarray(origin, float)
     rays /= np.maximum(np.hypot(*rays.T), 1e-9)[:, None]   # in base_footprint
+    laser = np.asarray(origin, float)[None]
     for _ in range(ITERATIONS):
         world = to_parent(pose, base_points)
-        near, normal, d, use = _taking_part(field, world, small, reach)
+        near, normal, d, use = _taking_part(field, world, small, reach,
+                                            to_parent(pose, laser)[0])
         if np.count_nonzero(use) < MIN_MATCHED:
             return Match(prior, False, int(np.count_nonzero(use)), math.nan)
         c, s = math.cos(pose[2]), math.sin(pose[2])
@@ -349,19 +413,44 @@ def align(base_points: NDArray[np.float64], predicted: NDArray[np.float64],
         # and by its incidence: the wall's normal in base_footprint against its ray
         n_base = np.column_stack((c * n[:, 0] + s * n[:, 1], -s * n[:, 0] + c * n[:, 1]))
         w_ret = weight_all[use] * np.einsum('ij,ij->i', n_base, rays[use]) ** 2
-        h = (jac.T * w_ret) @ jac + INFO_PRIOR
-        b = (jac.T * w_ret) @ res + INFO_PRIOR @ off
+        h = (jac.T * w_ret) @ jac + info_prior
+        b = (jac.T * w_ret) @ res + info_prior @ off
         step = -np.linalg.solve(h, b)
         pose = pose + step
         if np.hypot(step[0], step[1]) < CONVERGED and abs(step[2]) < CONVERGED:
             break
     off = pose - prior
     off[2] = math.remainder(off[2], 2 * math.pi)
-    _, _, d, use = _taking_part(field, to_parent(pose, base_points), small, reach)
+    _, _, d, use = _taking_part(field, to_parent(pose, base_points), small, reach,
+                                to_parent(pose, laser)[0])
     matched = int(np.count_nonzero(use))
     shift = float(np.hypot(off[0], off[1]))
-    ok = matched >= MIN_MATCHED and shift <= MAX_STEP_XY and abs(off[2]) <= MAX_STEP_YAW
+    ok = matched >= MIN_MATCHED and shift <= max_step[0] and abs(off[2]) <= max_step[1]
     if ok and pieces is not None:
         ok = landmarks(base_points[use], pieces[use], mover_size) >= MIN_PIECES
     rms = float(np.sqrt(np.mean(d[use] ** 2))) if matched else math.nan
     return Match(pose if ok else prior, bool(ok), matched, rms)
+
+
+def localise(base_points: NDArray[np.float64], predicted: NDArray[np.float64],
+             field: DistanceField | None, pieces: NDArray[np.int64] | None = None,
+             mover_size: float = math.inf, noise: tuple[float, float] = (0.0, 0.0),
+             origin: tuple[float, float] = (0.0, 0.0)) -> Match:
+    """:func:`align` in a wider basin, for a pose from a localiser on a map the robot
+    already has (its error decimetres, not a wheel's millimetres): passes of
+    LOCALISE_REACH, coarse to fine, each from the last one's pose and drawn to the
+    prediction with the localiser's uncertainty (LOCALISE_SIGMA_*), then one at the
+    default reach; accepted when that last pass is and the pose moved no more than
+    LOCALISE_MAX_*. The arguments are align's."""
+    prior = np.asarray(predicted, float)
+    info = np.diag([LOCALISE_SIGMA_XY ** -2, LOCALISE_SIGMA_XY ** -2,
+                    LOCALISE_SIGMA_YAW ** -2])
+    pose, match = prior, Match(prior, False, 0, math.nan)
+    for reach in (*LOCALISE_REACH, MAX_CORRESPONDENCE):
+        match = align(base_points, pose, field, pieces, mover_size, noise, origin,
+                      reach=reach, max_step=(math.inf, math.inf), info_prior=info)
+        pose = match.pose
+    off = pose - prior
+    ok = match.accepted and math.hypot(off[0], off[1]) <= LOCALISE_MAX_XY and \
+        abs(math.remainder(off[2], 2 * math.pi)) <= LOCALISE_MAX_YAW
+    return Match(pose if ok else prior, bool(ok), match.matched, match.rms)

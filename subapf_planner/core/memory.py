@@ -30,7 +30,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy import ndimage
 
-from .alignment import MIN_WALL_AGE, DistanceField, Match, align, distance_field
+from .alignment import MIN_WALL_AGE, DistanceField, Match, align, distance_field, localise
 from .config import PlannerConfig
 from .known_map import KnownMap
 from .navigation import NavigationField, compute_field, nearest_free
@@ -261,12 +261,13 @@ class NavigationMemory:
         return True
 
     def align(self, base: ArrayLike, predicted: ArrayLike,
-              moving: tuple[NDArray, NDArray] | None = None) -> Match:
+              moving: tuple[NDArray, NDArray] | None = None, wide: bool = False) -> Match:
         """Match a scan's returns ``base`` (m, 2) in base_footprint [m] (scan_to_points
         at the identity, in beam order) to the map: the pose of base_footprint
         (core/alignment.py) from the ``predicted`` one (x, y, yaw) in the map's frame.
         ``moving``: discs (centres (k, 2), radii (k,) [m]) whose returns, and
-        MOVING_MARGIN around them, take no part. The distance field is reused for
+        MOVING_MARGIN around them, take no part. ``wide``: in the wider basin of a
+        localiser's error (alignment.localise). The distance field is reused for
         DISTANCE_FIELD_SCANS scans while it covers the scan."""
         base = np.asarray(base, float).reshape(-1, 2)
         pred = np.asarray(predicted, float)
@@ -289,12 +290,14 @@ class NavigationMemory:
             self._distance = distance_field(g.log_odds, g.origin, g.resolution, here,
                                             DISTANCE_FIELD_MARGIN, g.hit_offset,
                                             g.established_at, g.scans,
-                                            scans_in(MIN_WALL_AGE, self.cfg.period))
+                                            scans_in(MIN_WALL_AGE, self.cfg.period),
+                                            g.hit_count)
             self._distance_age = 0
         self._distance_age += 1
-        return align(base, pred, self._distance, pieces, self.cfg.max_mover_size,
-                     (self.cfg.range_noise_floor, self.cfg.range_noise_fraction),
-                     self.cfg.laser_mount[:2])
+        return (localise if wide else align)(
+            base, pred, self._distance, pieces, self.cfg.max_mover_size,
+            (self.cfg.range_noise_floor, self.cfg.range_noise_fraction),
+            self.cfg.laser_mount[:2])
 
     def avoid(self, point: ArrayLike, radius: float, until: float) -> None:
         """Block the cells within ``radius`` [m] of ``point`` in the navigation field

@@ -35,7 +35,7 @@ import math
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from .alignment import Match, within_drift
+from .alignment import LOCALISE_TIME, Match, within_drift
 from .blind_spots import blind_obstacles
 from .command import Command
 from .config import PlannerConfig
@@ -192,6 +192,8 @@ class Planner:
         self.match: Match | None = None          # the last scan's alignment
         self._aligned_stamp: float | None = None
         self._aligned_from: NDArray | None = None   # odom pose of the last scan matched
+        #: Scans left to match in a localiser's basin (start_from; alignment.localise).
+        self._localising = 0
         self._goal: tuple[NDArray, NDArray] | None = None   # (in odom, in the memory's frame)
         self._planned_from: NDArray | None = None   # the last cycle's pose (memory's frame)
         #: Odometry's distance and turn scales, learnt (with odometry_calibration).
@@ -322,6 +324,15 @@ class Planner:
         # odometry's motion since the last scan: the most the pose may be corrected by
         distance, turn = (0.0, 0.0) if moved is None else (math.hypot(moved[0], moved[1]),
                                                             moved[2])
+        if self._localising > 0:   # a localiser's map -> odom: its error, not drift
+            self._localising -= 1
+            self.match = self.memory.align(base, predicted, discs, wide=True)
+            if self.match.accepted:
+                self._localising = 0
+                self.correction = tuple(float(v) for v in compose(self.match.pose,
+                                                                  invert(scan_pose)))
+                self.odometry.place(self.match.pose)
+                return
         if self.cfg.odometry_calibration:
             if moved is not None:   # the motion as calibrated
                 predicted = np.array(compose(self.in_map(last),
@@ -381,6 +392,7 @@ class Planner:
         self.forget()
         self.correction = tuple(float(v) for v in odom_in_map)
         self.memory.know(known)
+        self._localising = scans_in(LOCALISE_TIME, self.cfg.period)
 
     def follow(self, path: ArrayLike | None, in_map: bool = False) -> None:
         """Favour ``path`` (k, 2) [m] in the navigation field (path_discount) until the
