@@ -343,16 +343,19 @@ def with_map_off(ros_env, tmp_path, nav2_msgs_built, tf2_msgs_built):
              for k in {*nav2_msgs_built, *tf2_msgs_built}}
     g = Graph(int(ros_env['ROS_DOMAIN_ID']), tmp_path, paths, world_text=ROOM,
               sim_args=['-p', 'publish_map:=true', '-p', 'map_error_x:=0.1',
-                        '-p', 'map_error_yaw:=0.03'])
+                        '-p', 'map_error_yaw:=0.03', '-p', 'sensor:=ideal'])
     yield up(g)
     g.close()
 
 
 def test_with_a_localiser_off_by_a_decimetre_the_alignment_brings_the_robot_onto_the_map(
         with_map_off):
-    """map -> odom 0.1 m and 0.03 rad off (a localiser's error): the scan alignment
-    matches the scans to the map's walls, and the robot stops within 0.1 m of the goal's
-    true place (measured: 0.035 m; 0.14 m with scan_alignment off)."""
+    """map -> odom 0.1 m and 0.03 rad off (a localiser's error): the first scans are
+    matched to the map's walls in a localiser's basin (alignment.localise), and the
+    robot stops within 0.1 m of the goal's true place. The ideal lidar keeps the
+    localiser's error apart from the drift a noisy lidar's matches add over the drive
+    (the bench's pose error figures). Measured with the same world in
+    sim/episode.run_episode: 0.035 m; 0.19 m with scan_alignment off."""
     graph = with_map_off
     graph.until(lambda: 'memory started from the map' in (
         graph.log_dir / 'planner.log').read_text(), 60, 'the planner taking the map')
