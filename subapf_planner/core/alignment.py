@@ -135,15 +135,16 @@ class DistanceField:
     """For the cells of a window (rows = y; cell (0, 0) with its corner at ``origin``
     [m]; ``shape`` (h, w)): which established obstacle cell is the nearest (``index``,
     h * w + 1, the cells flat, row by row, then one for points off the window: its row
-    in ``table``), and per wall cell (k of them) a row of ``table`` (k + 1, 6): the wall
+    in ``table``), and per wall cell (k of them) a row of ``table`` (k + 1, 8): the wall
     point (x, y) [m], the wall's unit normal there (x, y), ``inf`` where the memory's
     wall ends but the wall may go on (:func:`_ends`; else 0: added to the distance, it
-    leaves no distance there) and 1 where it was established fewer than
+    leaves no distance there), 1 where it was established fewer than
     ``min_wall_scans`` scans before the field was made (OccupancyGrid.established_at;
-    else 0). The last row, k, is for points off the window: no wall point, an end (no
-    distance), not new. The table is per wall cell, not per window cell: a field is made every few
-    scans and read at a few hundred returns, so what a return needs is looked up, in
-    one gather, when it is asked for."""
+    else 0) and the normal turned to the free side of a map's face (x, y; zeros where
+    either side: _free_side). The last row, k, is for points off the window: no wall
+    point, an end (no distance), not new, either side. The table is per wall cell, not
+    per window cell: a field is made every few scans and read at a few hundred returns,
+    so what a return needs is looked up, in one gather, when it is asked for."""
 
     index: NDArray[np.int32]
     table: NDArray[np.float64]
@@ -159,11 +160,7 @@ class DistanceField:
         beyond it, where the memory has not seen the wall yet), and whether that wall
         cell has been established for fewer than ``min_wall_scans`` scans (n,) (False
         outside the window)."""
-        cells = np.floor((points - self.origin) / self.resolution).astype(np.int64)
-        h, w = self.shape
-        col, row = cells[:, 0], cells[:, 1]
-        inside = (col >= 0) & (row >= 0) & (col < w) & (row < h)
-        found = self.table[self.index[np.where(inside, row * w + col, -1)]]
+        found = self.table[self._rows(points)]
         near = found[:, :2]
         d = np.hypot(*(points - near).T) + found[:, 4]
         return near, found[:, 2:4], d, found[:, 5] > 0.0
@@ -171,11 +168,15 @@ class DistanceField:
     def free_side(self, points: NDArray[np.float64]) -> NDArray[np.float64]:
         """Per point (n, 2): the free side of its nearest wall point's face, as a unit
         normal, where only one side is free (a map's face: _free_side); zeros else."""
+        return self.table[self._rows(points), 6:8]
+
+    def _rows(self, points: NDArray[np.float64]) -> NDArray[np.int32]:
+        """Each point's row of ``table`` (its nearest wall cell's; the last off the window)."""
         cells = np.floor((points - self.origin) / self.resolution).astype(np.int64)
         h, w = self.shape
         col, row = cells[:, 0], cells[:, 1]
         inside = (col >= 0) & (row >= 0) & (col < w) & (row < h)
-        return self.table[self.index[np.where(inside, row * w + col, -1)], 6:8]
+        return self.index[np.where(inside, row * w + col, -1)]
 
 
 def _ends(wall: NDArray[np.bool_], normal: NDArray[np.float64],
