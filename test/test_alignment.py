@@ -112,7 +112,7 @@ def test_a_known_maps_thick_wall_is_matched_at_its_face():
     returns, are matched where the returns fell)."""
     g = OccupancyGrid(RES, 20.0, hit_places=True)
     g.know(thick_room())
-    inside = np.array([[-3.025, 0.325]])   # in the left wall (face at -2.95), a cell deep
+    inside = np.array([[-3.025, 0.325]])   # in the left wall, a cell behind its face
     face = distance_field(g.log_odds, g.origin, RES, inside, 0.4, g.hit_offset,
                           hit_count=g.hit_count)
     assert face.lookup(inside)[2][0] == pytest.approx(0.05, abs=0.01)
