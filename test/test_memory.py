@@ -11,7 +11,7 @@ import pytest
 from subapf_planner.core.config import PlannerConfig
 from subapf_planner.core.memory import NavigationMemory
 from subapf_planner.core.navigation import NEIGHBOURS, compute_field, densify, thin_polyline
-from subapf_planner.core.occupancy import HIT, LOG_ODDS_MAX, MISS, OccupancyGrid
+from subapf_planner.core.occupancy import LOG_ODDS_MAX, OccupancyGrid
 from subapf_planner.core.planner import Planner
 from subapf_planner.core.scan import Scan
 from subapf_planner.core.status import Status
@@ -326,29 +326,6 @@ def test_a_goal_a_few_centimetres_inside_the_inflation_is_led_to_beside_it(coars
     end = f.path(robot, 5.0)[-1]
     assert np.hypot(*(end - f.goal)) < 0.1 and end[1] > 1.19   # led there, not into the wall
     assert field((1.525, 1.025), 0.075) is None      # on the wall: 0.1 m to a free cell
-
-
-@pytest.mark.parametrize('log_odds, open_', [(HIT + MISS - 0.4, True), (HIT + MISS, True),
-                                              (HIT, False)])
-def test_cells_hit_once_and_seen_free_since_close_no_way(log_odds, open_):
-    """A ring open towards +x whose opening holds cells of ``log_odds``: hit once and
-    seen free twice (0.1) or once (0.5, WEAK_WALL), they leave the way out open; hit
-    and not seen free since (HIT), they close it. A place tried stays closed even so."""
-    mem = NavigationMemory(PlannerConfig(field_worker=False))
-    ranges, amin, inc, rmin, rmax = enclosure_scan(1.0)
-    ranges = ranges.copy()
-    ranges[:20] = ranges[-20:] = np.inf
-    mem.integrate(Scan(ranges, amin, inc, rmin, rmax, 0.0), (0.0, 0.0, 0.0))
-    g = mem.grid
-    across = np.column_stack((np.full(15, 1.0), np.linspace(-0.35, 0.35, 15)))
-    cells = g.cell_of(across)
-    g.log_odds[cells[:, 0], cells[:, 1]] = log_odds
-    g.version += 1
-    field, _ = mem.field_for((0.0, 0.0), (3.0, 0.0), now=0.0)
-    assert (field is not None and field.reachable((0.0, 0.0))) == open_
-    mem.avoid((1.0, 0.0), 0.4, until=10.0)
-    field, _ = mem.field_for((0.0, 0.0), (3.0, 0.0), now=1.0)
-    assert not field.reachable((0.0, 0.0))
 
 
 def test_the_memory_says_why_it_holds_no_way():

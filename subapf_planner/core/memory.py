@@ -34,7 +34,7 @@ from .alignment import MIN_WALL_AGE, DistanceField, Match, align, distance_field
 from .config import PlannerConfig
 from .known_map import KnownMap
 from .navigation import NavigationField, compute_field, nearest_free
-from .occupancy import ESTABLISHED, HIT, MISS, NOT_ESTABLISHED, OccupancyGrid
+from .occupancy import ESTABLISHED, NOT_ESTABLISHED, OccupancyGrid
 from .robot import compose, to_parent
 from .scan import Scan, scans_in
 from .tracking import clusters
@@ -46,11 +46,6 @@ SAME_GOAL = 1e-3
 DISTANCE_FIELD_SCANS = 5
 #: ... and covers this much around the scan that made it [m].
 DISTANCE_FIELD_MARGIN = 1.0
-#: Occupied cells with log odds at or below this (one hit outweighed by a miss since)
-#: close no way on their own: a field with no way from the robot is marched again
-#: without them (NavigationMemory._compute). A cell hit once by noise, a mixed pixel or
-#: a passer-by and seen free twice (log odds 0.1) closed doors and sat on goals.
-WEAK_WALL = HIT + MISS
 #: Returns this far beyond a moving track's disc are the alignment's again [m].
 MOVING_MARGIN = 0.3
 #: The route a field favours is its descent this far from the robot [m] (beyond the
@@ -86,8 +81,6 @@ class FieldJob:
     #: The way the field favours (compute_field's route), how much cheaper travel along
     #: it is and within what half-width [m] (Route).
     route: Route | None = None
-    #: The occupied cells that close no way on their own (WEAK_WALL; None: none).
-    weak: NDArray[np.bool_] | None = None
 
 
 @dataclass(frozen=True)
@@ -185,7 +178,7 @@ class NavigationMemory:
             self._worker = ThreadPoolExecutor(max_workers=1, thread_name_prefix='field')
             weakref.finalize(self, self._worker.shutdown, wait=False)
         self._pending = (self._worker.submit(self._compute, job.blocked, job.origin, job.goal,
-                                             job.position, job.route, job.weak), job)
+                                             job.position, job.route), job)
 
     def settle(self) -> None:
         """Start the field due and wait until it is done; the next call takes it as it
@@ -199,33 +192,24 @@ class NavigationMemory:
         """Take the map as it is now for a field to march between cycles
         (start_marching); the next call takes that field."""
         key = self._key(goal)
-        blocked, weak = self._blocked(now)
-        self._due = FieldJob(blocked, self.grid.origin.copy(), goal, position, key, now,
-                             self._route_for(key), weak)
+        self._due = FieldJob(self._blocked(now), self.grid.origin.copy(), goal, position,
+                             key, now, self._route_for(key))
 
     def _compute(self, blocked: NDArray[np.bool_], origin: NDArray, goal: NDArray,
-                 position: NDArray, route: Route | None, weak: NDArray[np.bool_] | None = None
+                 position: NDArray, route: Route | None
                  ) -> tuple[NavigationField | None, float, NDArray | None]:
         """The field, how long it took [s], and, with route_discount, its descent from
-        ``position`` (the route the next field favours). A field with no way from
-        ``position`` is marched again without the ``weak`` cells: a cell hit once and
-        seen free since (WEAK_WALL) does not close a door or sit on the goal."""
+        ``position`` (the route the next field favours)."""
         cfg = self.cfg
         t0 = time.perf_counter()
-
-        def march(cells: NDArray[np.bool_]) -> NavigationField | None:
-            return compute_field(cells, origin, self.grid.resolution, goal, position,
-                                 inflation_radius=cfg.inflation_radius,
-                                 clearance_band=cfg.inflation_band,
-                                 coarsening=cfg.field_coarsening,
-                                 route=None if route is None else route.points,
-                                 route_discount=0.0 if route is None else route.discount,
-                                 route_width=0.0 if route is None else route.width,
-                                 gap_clearance=cfg.gap_clearance, goal_slack=cfg.goal_slack)
-        field = march(blocked)
-        if (field is None or not field.reachable(position)) and weak is not None \
-                and weak.any():
-            field = march(blocked & ~weak)
+        field = compute_field(blocked, origin, self.grid.resolution, goal, position,
+                              inflation_radius=cfg.inflation_radius,
+                              clearance_band=cfg.inflation_band,
+                              coarsening=cfg.field_coarsening,
+                              route=None if route is None else route.points,
+                              route_discount=0.0 if route is None else route.discount,
+                              route_width=0.0 if route is None else route.width,
+                              gap_clearance=cfg.gap_clearance, goal_slack=cfg.goal_slack)
         seconds = time.perf_counter() - t0
         if field is None or cfg.route_discount <= 0.0 or self.path is not None:
             return field, seconds, None
@@ -324,15 +308,13 @@ class NavigationMemory:
         self._field_key = None
         self._drop_pending()
 
-    def _blocked(self, now: float | None) -> tuple[NDArray[np.bool_], NDArray[np.bool_]]:
-        """The occupied cells plus the avoided places still in force at ``now``, and the
-        occupied cells that close no way on their own (WEAK_WALL), outside those places."""
+    def _blocked(self, now: float | None) -> NDArray[np.bool_]:
+        """The occupied cells plus the avoided places still in force at ``now``."""
         occ = self.grid.occupied()
-        weak = occ & (self.grid.log_odds <= WEAK_WALL)
         if now is not None:
             self.avoided = [a for a in self.avoided if now < a[3]]
         if not self.avoided:
-            return occ, weak
+            return occ
         res, origin = self.grid.resolution, self.grid.origin
         for x, y, r, _ in self.avoided:
             c0, r0 = (int(v) for v in np.floor((np.array([x, y]) - r - origin) / res))
@@ -343,10 +325,8 @@ class NavigationMemory:
                 continue
             cy = origin[1] + (np.arange(r0, r1) + 0.5) * res
             cx = origin[0] + (np.arange(c0, c1) + 0.5) * res
-            disc = (cx[None] - x) ** 2 + (cy[:, None] - y) ** 2 <= r * r
-            occ[r0:r1, c0:c1] |= disc
-            weak[r0:r1, c0:c1] &= ~disc
-        return occ, weak
+            occ[r0:r1, c0:c1] |= (cx[None] - x) ** 2 + (cy[:, None] - y) ** 2 <= r * r
+        return occ
 
     def no_way(self, position: ArrayLike, goal: ArrayLike) -> str:
         """Why the memory holds no way from ``position`` to ``goal`` (x, y) [m] (a query,
@@ -465,7 +445,7 @@ class NavigationMemory:
                 and timed:
             self._march_later(g, p, now)   # only the map's changes: the next call has it
             return self.field, self.computations != installed
-        blocked, weak = self._blocked(now if timed else None)
-        self._install(self._compute(blocked, self.grid.origin, g, p, self._route_for(key),
-                                    weak), key, now if timed else -math.inf)
+        self._install(self._compute(self._blocked(now if timed else None), self.grid.origin,
+                                    g, p, self._route_for(key)), key,
+                      now if timed else -math.inf)
         return self.field, True
