@@ -151,6 +151,8 @@ class DistanceField:
     shape: tuple[int, int]
     origin: NDArray[np.float64]
     resolution: float
+    #: Whether any face is seen from one side only (a map's: _free_side).
+    one_sided: bool = False
 
     def lookup(self, points: NDArray[np.float64]
                ) -> tuple[NDArray, NDArray, NDArray, NDArray]:
@@ -257,8 +259,11 @@ def distance_field(log_odds: NDArray[np.float32], origin: NDArray[np.float64],
         return None
     wall = log_odds[r0:r1, c0:c1] >= ESTABLISHED
     free = log_odds[r0:r1, c0:c1] < 0.0
-    if hit_count is not None:
-        wall &= (hit_count[r0:r1, c0:c1] > 0) | ndimage.binary_dilation(free)
+    unhit = None if hit_count is None else wall & (hit_count[r0:r1, c0:c1] == 0)
+    if unhit is not None and unhit.any():   # a map's walls: their faces only
+        wall &= ~unhit | ndimage.binary_dilation(free)
+    else:
+        unhit = None
     if not np.any(wall):
         return None
     rows, cols = ndimage.distance_transform_edt(~wall, return_distances=False,
@@ -278,12 +283,13 @@ def distance_field(log_odds: NDArray[np.float32], origin: NDArray[np.float64],
     table = np.zeros((wall_rows.size + 1, 8))
     table[:-1, 0:2], table[:-1, 2:4] = point, normals
     table[:-1, 4], table[:-1, 5] = np.where(end, np.inf, 0.0), new
-    if hit_count is not None:   # a map's face: which side of it is free
-        table[:-1, 6:8] = _free_side(free, hit_count[r0:r1, c0:c1][wall_rows, wall_cols] == 0,
-                                     wall_rows, wall_cols, normals)
+    if unhit is not None:   # a map's face: which side of it is free
+        table[:-1, 6:8] = _free_side(free, unhit[wall_rows, wall_cols], wall_rows, wall_cols,
+                                     normals)
     table[-1, 4] = np.inf   # off the window: no wall point, an end (no distance), not new
     return DistanceField(np.append(index[rows, cols].ravel(), np.int32(wall_rows.size)),
-                         table, wall.shape, corner, resolution)
+                         table, wall.shape, corner, resolution,
+                         bool(np.any(table[:, 6:8])))
 
 
 def within_drift(predicted: NDArray[np.float64], matched: NDArray[np.float64],
@@ -359,7 +365,7 @@ def _taking_part(field: DistanceField, world: NDArray[np.float64],
     its near face, offset)."""
     near, normal, d, young = field.lookup(world)
     use = _beside(world, near, normal, d, field.resolution, reach) & ~(small & young)
-    if eye is not None:
+    if eye is not None and field.one_sided:
         side = field.free_side(world)
         use &= np.einsum('ij,ij->i', side, eye - near) >= 0.0
     return near, normal, d, use

@@ -329,9 +329,7 @@ class Planner:
             self.match = self.memory.align(base, predicted, discs, wide=True)
             if self.match.accepted:
                 self._localising = 0
-                self.correction = tuple(float(v) for v in compose(self.match.pose,
-                                                                  invert(scan_pose)))
-                self.odometry.place(self.match.pose)
+                self._place(self.match.pose, scan_pose)
                 return
         if self.cfg.odometry_calibration:
             if moved is not None:   # the motion as calibrated
@@ -347,6 +345,12 @@ class Planner:
         pose = predicted
         if moved is not None and self.match.accepted:
             pose = within_drift(predicted, self.match.pose, distance, turn)
+        self._place(pose, scan_pose)
+
+    def _place(self, pose: NDArray, scan_pose: NDArray) -> None:
+        """The correction that puts the odom pose ``scan_pose`` at ``pose`` (x, y, yaw) in
+        the memory's frame (unchanged when it is there already), and odometry's
+        calibration told where the scan was taken."""
         if not np.array_equal(pose, self.in_map(scan_pose)):
             self.correction = tuple(float(v) for v in compose(pose, invert(scan_pose)))
         self.odometry.place(pose)
