@@ -11,7 +11,7 @@ import rclpy
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.parameter import Parameter
 from rclpy.qos import QoSProfile, qos_profile_sensor_data
-from sensor_msgs.msg import LaserScan
+from sensor_msgs.msg import LaserScan, TimeReference
 from std_msgs.msg import String
 
 from subapf_planner.core.scan import Scan
@@ -294,8 +294,11 @@ def test_views_are_built_only_while_something_subscribes(harness, monkeypatch):
 
 def test_scans_and_odometry_are_taken_at_the_tick_not_by_the_executor(harness):
     """The inputs' subscriptions are in a group the executor never runs (PolledGroup):
-    a scan and odometry that arrived wait in their queues until the planning tick."""
+    a scan and odometry that arrived wait in their queues until the planning tick,
+    which says on ~/taken that it took them (what a replay follows: bag/events.py)."""
     h = harness(planning_frequency=0.5)
+    refs = []
+    h.peer.create_subscription(TimeReference, '/subapf_planner/taken', refs.append, 50)
     # the peer hears the same inputs through ordinary subscriptions, which the executor
     # runs: when it has them, they have reached this process
     heard = {'scan': 0, 'odom': 0}
@@ -310,7 +313,7 @@ def test_scans_and_odometry_are_taken_at_the_tick_not_by_the_executor(harness):
     assert h.spin_until(lambda: any(s.startswith('waiting') for s in h.states), timeout=8.0)
     for _ in range(3):   # just after a tick: the next is two seconds away
         h.feed()
-    polled = [sub for sub, _ in h.node._inputs]
+    polled = [sub for sub, *_ in h.node._inputs]
     assert all(not sub.callback_group.can_execute(sub) for sub in polled)
     # the executor ran until the peer had them all, and 0.3 s more; the 0.5 Hz tick did not
     assert h.spin_until(lambda: heard == {'scan': 3, 'odom': 3}, timeout=1.0), heard
@@ -318,6 +321,12 @@ def test_scans_and_odometry_are_taken_at_the_tick_not_by_the_executor(harness):
     assert h.node.ctl.scan is None and h.node.ctl.pose is None
     assert h.spin_until(lambda: bool(h.cmds), timeout=5.0)   # the tick took them in
     assert h.node.ctl.scan is not None and h.node.ctl.pose is not None
+    tick = h.cmds[0].header.stamp
+    assert h.spin_until(lambda: sum(r.header.stamp == tick for r in refs) == 6, timeout=2.0)
+    at_tick = [r for r in refs if r.header.stamp == tick]
+    assert sorted(r.source for r in at_tick) == ['odom'] * 3 + ['scan'] * 3
+    assert len({(r.time_ref.sec, r.time_ref.nanosec) for r in at_tick}) == 3   # as fed
+    assert [r.source for r in refs if r.header.stamp != tick] == ['goal_pose']
 
 
 def test_a_publisher_the_polled_inputs_cannot_hear_is_reported(harness, capfd):
@@ -364,7 +373,7 @@ def test_the_executor_sleeps_while_polled_messages_wait(harness):
     message is unread) is in its wait set, so between ticks the process rests."""
     import time
     h = harness(planning_frequency=0.5)
-    polled = [sub for sub, _ in h.node._inputs]
+    polled = [sub for sub, *_ in h.node._inputs]
     entities = [e for sub in polled for e in (sub, *sub.event_handlers)]
     assert not any(e.callback_group.can_execute(e) for e in entities)
     h.wait_matched()

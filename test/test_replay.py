@@ -7,12 +7,21 @@ from mcap.writer import Writer
 import numpy as np
 import pytest
 from rclpy.serialization import serialize_message
+from sensor_msgs.msg import TimeReference
+from std_msgs.msg import Header
 
-from subapf_planner.bag.events import PLAIN_CMD, events, stamp_ns
+from subapf_planner.bag.events import (
+    PLAIN_CMD,
+    TAKEN_TOPIC,
+    TAKEN_TYPE,
+    events,
+    stamp_ns,
+)
 from subapf_planner.bag.reader import BagError, read, topics
 from subapf_planner.bag.writer import McapRecorder
 from subapf_planner.core.config import load_config
 from subapf_planner.core.loop import Supervision
+from subapf_planner.ros.conversions import ns_to_stamp
 from subapf_planner.ros.replay import replay
 from subapf_planner.ros.replay_dds import replay_through_node
 from subapf_planner.tools.replay import main as replay_main
@@ -214,6 +223,74 @@ def test_twist_bag_gets_the_ticks_of_the_stamped_one(tmp_path):
     np.testing.assert_array_equal(a.times[:-1], b.times[:-1])
     np.testing.assert_array_equal(a.recorded, b.recorded)
     np.testing.assert_array_equal(a.replayed[:-1], b.replayed[:-1])
+
+
+def taken_bag(src: Path, out: Path, late: int | None = None) -> Path:
+    """``src`` (recorded without ~/taken) with the ~/taken a planner_node sends: each
+    input at the tick events() gives it (planner_node takes at a tick what is stamped
+    up to it), and scan number ``late`` a tick later, as a node takes a scan that
+    reached it after the clock."""
+    stream = events(src, NAMES)
+    ticks = sorted({e.time_ns for e in stream if e.role == 'cmd_vel'})
+    refs, scans = [], 0
+    for k, e in enumerate(stream):
+        if e.role == 'cmd_vel':
+            continue
+        # the tick that plans with it: the first command after it in the stream
+        tick = next((f.time_ns for f in stream[k:] if f.role == 'cmd_vel'), None)
+        if tick is None:
+            continue
+        if e.role == 'scan':
+            if scans == late:
+                tick = ticks[ticks.index(tick) + 1]
+            scans += 1
+        refs.append(TimeReference(header=Header(stamp=ns_to_stamp(tick)),
+                                  time_ref=e.message.header.stamp,
+                                  source={'goal': 'goal_pose'}.get(e.role, e.role)))
+    rec = McapRecorder(out)
+    try:
+        last = 0
+        for m in read(src, {'/scan', '/odom', '/goal_pose', '/clock', '/cmd_vel'}):
+            rec.add_topic(m.topic, m.type_name)
+            rec.write(m.topic, serialize_message(m.message), m.log_time_ns)
+            last = m.log_time_ns
+        rec.add_topic(TAKEN_TOPIC, TAKEN_TYPE)
+        for i, ref in enumerate(refs):
+            rec.write(TAKEN_TOPIC, serialize_message(ref), last + i + 1)
+    finally:
+        rec.close()
+    return out
+
+
+def test_a_bag_with_taken_is_replayed_where_the_node_took_each_input(tmp_path):
+    """With the node's ~/taken in the bag each input is replayed at the tick the node
+    says it took it (bag/events.py): a record of where the recording order put them
+    replays as that order does, command for command; the same record with one scan
+    taken a tick late (a scan that reached the node after the clock) moves that scan,
+    and only that input, to the next tick, and the replay's commands then differ
+    from the tick the node planned without it."""
+    src = DATA / 'fig6c_circle_in_front.mcap'
+    cfg = load_config(PARAMS)
+    plain = replay(str(src), cfg, Supervision(), NAMES)
+    same = replay(str(taken_bag(src, tmp_path / 'same.mcap')), cfg, Supervision(), NAMES)
+    np.testing.assert_array_equal(same.times, plain.times)
+    np.testing.assert_array_equal(same.replayed, plain.replayed)
+
+    late = 40
+    bag = taken_bag(src, tmp_path / 'late.mcap', late)
+    on_time = [e for e in events(tmp_path / 'same.mcap', NAMES) if e.role != 'cmd_vel']
+    taken = [e for e in events(bag, NAMES) if e.role != 'cmd_vel']
+    assert len(taken) == len(on_time) > 100
+    moved = [e for e in taken if e not in on_time]
+    assert len(moved) == 1 and moved[0].role == 'scan'
+    was = next(e for e in on_time if e.message == moved[0].message)
+    ticks = sorted({e.time_ns for e in events(src, NAMES) if e.role == 'cmd_vel'})
+    t_late = moved[0].time_ns
+    assert t_late in ticks and ticks.index(t_late) == ticks.index(was.time_ns) + 1
+    shifted = replay(str(bag), cfg, Supervision(), NAMES)
+    differ = np.flatnonzero(np.any(shifted.replayed != plain.replayed, axis=1))
+    assert differ.size and shifted.times[differ[0]] * 1e9 == pytest.approx(
+        ticks[ticks.index(t_late) - 1])
 
 
 @pytest.mark.dds

@@ -20,6 +20,18 @@ events at the same simulated times in the same order:
 value when the bag has that topic, among the messages logged before. Events are
 sorted by time; at equal times inputs come first, then goals, then commands (the
 node ticks after what it has received), each kind in log order.
+
+That is where the node most likely took each input; where it truly did, the node
+says on ``~/taken`` (planner_node: a TimeReference per scan, odometry and goal_pose
+message, stamped with the tick it was taken at). A bag with that topic (and stamped
+commands) is replayed by it: each scan and odometry message at the tick that took it
+(matched by stamp), the n-th goal at the tick of the n-th goal taken, in the order
+the node took them: before the tick's command, but for scans and odometry stamped
+after the tick, which the node takes after its command; inputs the node never
+received are left out (those stamped before the first tick it tells of, which the
+recorder may have missed, at their stamps). DDS orders no two topics, so a scan the simulator sent
+before its clock may reach the node after the tick (on a loaded machine) and the
+recorder in the other order.
 """
 
 from __future__ import annotations
@@ -40,6 +52,11 @@ PLAIN_CMD = 'geometry_msgs/msg/Twist'
 #: Accepted cmd_vel types (the node's enable_stamped_cmd_vel true / false).
 CMD_TYPES = (STAMPED_CMD, PLAIN_CMD)
 ROLES = ('scan', 'odom', 'goal', 'cmd_vel')
+#: The planner node's record of what it took (optional in a bag: ``names['taken']``).
+TAKEN_TOPIC = '/subapf_planner/taken'
+TAKEN_TYPE = 'sensor_msgs/msg/TimeReference'
+#: ~/taken's source per role.
+TAKEN_SOURCE = {'scan': 'scan', 'odom': 'odom', 'goal': 'goal_pose'}
 CLOCK_TOPIC = '/clock'
 CLOCK_TYPE = 'rosgraph_msgs/msg/Clock'
 #: Order among events at the same time.
@@ -85,8 +102,13 @@ def check_topics(path: str | Path, names: dict[str, str]) -> str:
 
 def events(path: str | Path, names: dict[str, str]) -> list[Event]:
     """The bag's scan, odom, goal and cmd_vel messages as time-ordered events (see the
-    module docstring). Checks the topics first (check_topics)."""
-    check_topics(path, names)
+    module docstring). Checks the topics first (check_topics). ``names`` maps each
+    role to its topic, and optionally 'taken' to the node's ~/taken (default
+    TAKEN_TOPIC)."""
+    stamped = check_topics(path, names) == STAMPED_CMD
+    taken_topic = names.get('taken', TAKEN_TOPIC)
+    if stamped and topics(path).get(taken_topic) == TAKEN_TYPE:
+        return _as_taken(path, names, taken_topic)
     role = {topic: r for r, topic in names.items() if r in ROLES}
     wanted = set(role)
     if topics(path).get(CLOCK_TOPIC) == CLOCK_TYPE and CLOCK_TOPIC not in wanted:
@@ -114,6 +136,48 @@ def events(path: str | Path, names: dict[str, str]) -> list[Event]:
             t = now
         out.append((t, _RANK[r], i, Event(t, r, m.message)))
     out = _snap_plain_commands(out)
+    out.sort(key=lambda e: e[:3])
+    return [e[3] for e in out]
+
+
+def _as_taken(path: str | Path, names: dict[str, str], taken_topic: str) -> list[Event]:
+    """Events of a bag with the node's ~/taken and stamped commands (module docstring):
+    each input at the tick that took it, in the order taken, before the tick's command
+    or, stamped after the tick, after it."""
+    role = {topic: r for r, topic in names.items() if r in ROLES}
+    ticks: dict[tuple[str, int], tuple[int, int]] = {}   # (source, stamp) -> (tick, order)
+    goal_ticks: list[tuple[int, int]] = []
+    messages = []
+    for k, m in enumerate(read(path, set(role) | {taken_topic})):
+        if m.topic != taken_topic:
+            messages.append((role[m.topic], m))
+            continue
+        ref = m.message
+        at = (stamp_ns(ref.header.stamp), k)   # the tick, and the order taken
+        if ref.source == TAKEN_SOURCE['goal']:
+            goal_ticks.append(at)
+        else:
+            ticks.setdefault((ref.source, stamp_ns(ref.time_ref)), at)
+    # inputs stamped before the first tick ~/taken tells of: at their stamps
+    first = min((at[0] for at in (*ticks.values(), *goal_ticks)), default=0)
+    out: list[tuple[int, int, int, Event]] = []
+    goals = 0
+    for i, (r, m) in enumerate(messages):
+        if r == 'cmd_vel':
+            t = stamp_ns(m.message.header.stamp)
+            out.append((t, 1, i, Event(t, r, m.message)))
+            continue
+        stamp = stamp_ns(m.message.header.stamp)
+        if r == 'goal':
+            at = goal_ticks[goals] if goals < len(goal_ticks) else None
+            goals += 1
+        else:
+            at = ticks.get((TAKEN_SOURCE[r], stamp))
+            if at is None and stamp < first:   # before the recorder heard ~/taken
+                at = (stamp, -1)
+        if at is not None:   # (else the node never received it)
+            after = r != 'goal' and stamp > at[0]
+            out.append((at[0], 2 if after else 0, at[1], Event(at[0], r, m.message)))
     out.sort(key=lambda e: e[:3])
     return [e[3] for e in out]
 

@@ -12,9 +12,11 @@ Topics (relative, so namespaces and remapping work):
        ~/map (nav_msgs/OccupancyGrid, transient local, the occupancy memory),
        ~/plan (nav_msgs/Path, the navigation field's steepest descent, sent for each
        new field and as the robot moves), ~/correction (geometry_msgs/
-       TransformStamped map_frame -> odom: the scan alignment's drift correction);
-       markers, map and plan are drawn in odom; everything but cmd_vel is built and
-       sent only while something subscribes
+       TransformStamped map_frame -> odom: the scan alignment's drift correction),
+       ~/taken (sensor_msgs/TimeReference: each scan, odometry and goal_pose message
+       the node took, and the tick it took it at: what a replay of a recording
+       follows); markers, map and plan are drawn in odom; everything but
+       cmd_vel is built and sent only while something subscribes
 
 Scans and odometry are taken at the planning tick (ros/spinning.PolledGroup), so
 only the timer (and goals, parameters, /clock) wakes the process. While one of them
@@ -42,8 +44,8 @@ from rclpy.exceptions import ParameterException
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 from rclpy.qos import QoSProfile, qos_profile_sensor_data
-from sensor_msgs.msg import LaserScan
-from std_msgs.msg import String
+from sensor_msgs.msg import LaserScan, TimeReference
+from std_msgs.msg import Header, String
 from visualization_msgs.msg import MarkerArray
 
 from ..bag.events import stamp_ns
@@ -89,6 +91,8 @@ SILENCE_CHECK = 2.0
 #: Odometry queued between two ticks (taken at the tick, not on arrival): 2.5 s at 20 Hz,
 #: 10 planning periods of the default.
 ODOM_QUEUE = 50
+#: ~/taken's queue: a tick's inputs (a scan and four odometry messages at 5 Hz).
+TAKEN_QUEUE = 50
 #: /tf messages queued between two ticks (taken at the tick, for map -> odom).
 TF_QUEUE = 100
 
@@ -200,6 +204,9 @@ class PlannerParts:
         self.map_pub = self._publisher(GridMsg, '~/map', LATCHED)
         self.plan_pub = self._publisher(Path, '~/plan', 10)
         self.correction_pub = self._publisher(TransformStamped, '~/correction', 10)
+        self.taken_pub = self._publisher(TimeReference, '~/taken', TAKEN_QUEUE)
+        #: (role, stamp) of the inputs taken since the last ~/taken went out
+        self._taken: list[tuple[str, object]] = []
         self._map_time: float | None = None
         self._markers_time: float | None = None
         self._plan_sent: tuple | None = None   # (field, robot position, time) of ~/plan
@@ -207,9 +214,9 @@ class PlannerParts:
         polled = PolledGroup()
         self._inputs = (
             (self._subscription(LaserScan, 'scan', self._on_scan, qos_profile_sensor_data,
-                                callback_group=polled), self._on_scan),
+                                callback_group=polled), self._on_scan, 'scan'),
             (self._subscription(Odometry, 'odom', self._on_odom, QoSProfile(depth=ODOM_QUEUE),
-                                callback_group=polled), self._on_odom))
+                                callback_group=polled), self._on_odom, 'odom'))
         self._subscription(PoseStamped, 'goal_pose', self._on_goal, 10)
         self._silence_checked = -float('inf')   # when the silent inputs were looked at
         self._unheard: set[bytes] = set()   # publishers warned about (endpoint GIDs)
@@ -448,6 +455,7 @@ class PlannerParts:
         if not self.active:
             self.get_logger().warn('goal_pose ignored: the planner is not active')
             return
+        self._taken.append(('goal_pose', msg.header.stamp))
         if self.take_goal(msg) is None and self.actions is not None:
             self.actions.preempt('preempted by a goal on goal_pose')
 
@@ -493,11 +501,12 @@ class PlannerParts:
     def _take_arrived_inputs(self, tick_ns: int) -> list:
         """The scans and odometry that arrived since the last tick (the executor never
         hands them over: PolledGroup): those stamped at or before the tick are taken in
-        now, as a replay of the recording orders them; later ones are returned, to be
-        taken in after the tick."""
+        now; later ones are returned, to be taken in after the tick (each noted for
+        ~/taken)."""
         later = []
-        for sub, handler in self._inputs:
+        for sub, handler, role in self._inputs:
             for msg in taken(sub):
+                self._taken.append((role, msg.header.stamp))
                 if stamp_ns(msg.header.stamp) <= tick_ns:
                     handler(msg)
                 else:
@@ -512,7 +521,7 @@ class PlannerParts:
         if 0.0 <= now - self._silence_checked < SILENCE_CHECK:
             return
         self._silence_checked = now
-        for (sub, _), silent in zip(self._inputs, self.ctl.silent(now), strict=True):
+        for (sub, _, _), silent in zip(self._inputs, self.ctl.silent(now), strict=True):
             if not silent:
                 continue
             found = unheard_publishers(sub.topic_name, sub.msg_type, sub.qos_profile,
@@ -534,6 +543,7 @@ class PlannerParts:
             handler(msg)
         if decision.command is not None:   # the command first, stamped with the tick time
             self._publish_cmd(*decision.command, stamp=tick.to_msg())
+        self._publish_taken(tick)
         # then the scan into the memory (so ~/map shows it) and the field marched until
         # the next tick: neither holds the command up
         self.ctl.after_tick()
@@ -546,6 +556,19 @@ class PlannerParts:
             self.status_pub.publish(String(data=decision.text))
         if self.actions is not None:
             self.actions.after_tick(decision, tick.to_msg())
+
+    def _publish_taken(self, tick) -> None:
+        """~/taken: one TimeReference per input (role, stamp) taken at this tick or
+        since the last (header stamp: the tick; time_ref: the input's stamp; source: its
+        role), in the order taken; only while something subscribes. The tick planned
+        with all but the scans and odometry stamped after it, which were taken after its
+        command."""
+        inputs, self._taken = self._taken, []
+        if not inputs or not listened(self.taken_pub):
+            return
+        header = Header(stamp=tick.to_msg())
+        for role, stamp in inputs:
+            self.taken_pub.publish(TimeReference(header=header, time_ref=stamp, source=role))
 
     def _publish_views(self, decision, tick) -> None:
         """~/markers at marker_rate and ~/correction each cycle, each only while

@@ -12,7 +12,7 @@ from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from rclpy.signals import SignalHandlerOptions
 from rosgraph_msgs.msg import Clock
-from sensor_msgs.msg import LaserScan
+from sensor_msgs.msg import LaserScan, TimeReference
 from std_msgs.msg import String
 from visualization_msgs.msg import MarkerArray
 
@@ -40,6 +40,7 @@ RECORDED = {
     '/ground_truth': (Odometry, _RELIABLE),
     '/sim_outcome': (String, LATCHED),
     '/subapf_planner/status': (String, _RELIABLE),
+    '/subapf_planner/taken': (TimeReference, _RELIABLE),
     '/subapf_planner/markers': (MarkerArray, _RELIABLE),
     '/subapf_planner/plan': (Path, _RELIABLE),
     '/subapf_planner/map': (OccupancyGrid, _LATCHED_DEEP),

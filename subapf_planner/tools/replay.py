@@ -16,7 +16,7 @@ import sys
 import numpy as np
 
 from ..bag.comparison import Comparison
-from ..bag.events import STAMPED_CMD
+from ..bag.events import STAMPED_CMD, TAKEN_TOPIC
 from ..bag.reader import BagError
 from ..bag.writer import McapRecorder
 from ..core.config import METHODS, ConfigError, load_config, load_params_file
@@ -60,6 +60,9 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument('--odom-topic', default='/odom')
     p.add_argument('--goal-topic', default='/goal_pose')
     p.add_argument('--cmd-topic', default='/cmd_vel')
+    p.add_argument('--taken-topic', default=TAKEN_TOPIC,
+                   help="the planner node's ~/taken: when the bag has it, each input is "
+                        'replayed at the tick the node took it')
     args = p.parse_args(argv)
     try:
         params = args.params or default_params_file()
@@ -68,7 +71,7 @@ def main(argv: list[str] | None = None) -> int:
         limits = build(Supervision, values, ignore_unknown=True)
         options = build(NodeOptions, values, ignore_unknown=True)
         names = {'scan': args.scan_topic, 'odom': args.odom_topic, 'goal': args.goal_topic,
-                 'cmd_vel': args.cmd_topic}
+                 'cmd_vel': args.cmd_topic, 'taken': args.taken_topic}
         if args.through_node:
             from ..ros.replay_dds import replay_through_node
             domain = args.domain_id if args.domain_id is not None else random.randint(1, 100)
