@@ -434,7 +434,7 @@ class Planner:
                                      self.memory.standing(points, origin, 2.0 * noise,
                                                           scans_in(STANDING_TIME,
                                                                    self.cfg.period)),
-                                     beams * scan.beam_interval)
+                                     beams * scan.beam_interval, noise)
         transient = np.zeros(np.size(scan.ranges), bool)
         transient[beams] = tracks.held_points
         return tracks, transient

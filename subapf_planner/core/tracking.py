@@ -20,9 +20,17 @@ operations for every track at once; filterpy's per-object KalmanFilter costs a
 Python object per track per step for the same equations.
 
 A track **moves** when it has been seen MIN_HITS times, its estimated speed is
-at least ``moving_speed``, and it has been MOVE_DISTANCE from where it was
-first seen at some time (NEW_MOVE_DISTANCE if it was new then: standing on cells
-the memory had seen free; someone walking to and fro stays a mover). It is
+at least ``moving_speed``, it has been MOVE_DISTANCE from where it was first seen
+at some time (NEW_MOVE_DISTANCE if it was new then: standing on cells the memory
+had seen free; someone walking to and fro stays a mover), and it has left that
+place. How far it went is measured at the scans it is seen (not from predictions),
+less half the change of its cluster's extent (more or less of a standing object in
+view moves a centroid that much; not where the cluster stands on cells seen free:
+something walking out from behind an edge grows into view); and it has left the place
+when fewer than STILL_FRACTION of the points it was first seen at have a return
+within VACATED_RADIUS (or two standard deviations of the return's range noise):
+a piece of a long wall that noise and dropped beams cut out of it, sliding along
+it as the robot drives, is still where it began. It is
 **held** out of the occupancy memory while it moves, and while its cluster is new
 and stands mostly on cells the memory has seen free (something new where there
 was nothing: held NEW_OBJECT_SCANS scans, then written if it did not move).
@@ -77,6 +85,14 @@ MOVE_DISTANCE = 0.3
 #: this), too late to get out of its way; at this distance for every track, static
 #: clutter seemed to move and the gaps between it closed (docs/moving_obstacles.md).
 NEW_MOVE_DISTANCE = 0.15
+#: Points of a cluster kept from when its track was first seen ...
+FIRST_POINTS = 12
+#: ... and a track moves only once fewer than STILL_FRACTION of them have a return of
+#: the scan within VACATED_RADIUS [m] (or two standard deviations of that return's range
+#: noise): something that moves leaves the place it was first seen at, a piece of wall
+#: or clutter whose centroid only seems to move does not (tracking._still_there).
+STILL_FRACTION = 0.5
+VACATED_RADIUS = 0.1
 #: A cluster whose points lie this close to a line [m] (the smaller principal standard
 #: deviation), and that is longer than THIN_LENGTH [m], is a piece of wall: a wall seen
 #: at a grazing angle breaks into short straight pieces whose centroids slide along
@@ -202,8 +218,8 @@ class Tracker:
     """Tracks of one robot. Not thread-safe."""
 
     #: Per-track arrays, one row per track, appended and filtered together.
-    PER_TRACK = ('x', 'P', 'hits', 'misses', 'new_age', 'radius', 'ids', 'first', 'went',
-                 'moved')
+    PER_TRACK = ('x', 'P', 'hits', 'misses', 'new_age', 'radius', 'ids', 'first',
+                 'first_size', 'first_points', 'went', 'moved')
 
     def __init__(self, gap: float, max_size: float, gate: float, moving_speed: float) -> None:
         self.gap, self.max_size, self.gate, self.moving_speed = gap, max_size, gate, moving_speed
@@ -219,6 +235,9 @@ class Tracker:
         self.radius = np.zeros(0)
         self.ids = np.zeros(0, np.int64)
         self.first = np.zeros((0, 2))   # where each track was first seen [m]
+        self.first_size = np.zeros(0)    # its cluster's extent then [m]
+        # (n, FIRST_POINTS, 2) [m]: its cluster's points then (NaN: none)
+        self.first_points = np.zeros((0, FIRST_POINTS, 2))
         self.went = np.zeros(0)          # the farthest it has been from there [m]
         self.moved = np.zeros(0, bool)   # whether it moved at the last scan it was seen
         self._next_id = 0
@@ -270,13 +289,15 @@ class Tracker:
     def update(self, points: NDArray[np.float64], t: float,
                log_odds_at: NDArray[np.float64],
                standing: NDArray[np.bool_] | None = None,
-               after: NDArray[np.float64] | None = None) -> Tracks:
+               after: NDArray[np.float64] | None = None,
+               sigma: NDArray[np.float64] | None = None) -> Tracks:
         """Take a scan's obstacle points (n, 2) at time ``t`` [s] with the memory's log
         odds at each (n,; 0 off the map), whether each is on an obstacle that has stood
         STANDING_TIME (n,; none when not given) and how long after ``t`` each was
         taken (n, [s]; a spinning lidar's beam i is i * time_increment after the first:
         a walker seen late in the sweep is measured where it was then; none: all at
-        ``t``), before the scan is written; returns the tracks, at time ``t``.
+        ``t``) and each one's range noise (n, [m]; none: 0), before the scan is
+        written; returns the tracks, at time ``t``.
         A scan at the same time as the last is not taken again (the tracks stand)."""
         if self.time is not None and t == self.time and self._last is not None:
             return self._last   # the same scan again (a tick without a new one)
@@ -332,7 +353,9 @@ class Tracker:
                          misses=np.zeros(m, np.int64),
                          new_age=np.where(new[fresh] >= NEW_FRACTION, 0, -1).astype(np.int64),
                          radius=np.zeros(m), ids=self._next_id + np.arange(m),
-                         first=cents[fresh], went=np.zeros(m), moved=np.zeros(m, bool))
+                         first=cents[fresh], first_size=sizes[fresh],
+                         first_points=_some_points(points, labels, fresh), went=np.zeros(m),
+                         moved=np.zeros(m, bool))
             self._next_id += m
         keep = self.misses <= MAX_MISSES
         remap = np.cumsum(keep) - 1
@@ -342,7 +365,14 @@ class Tracker:
         visible = track_of >= 0
         self.radius[track_of[visible]] = 0.5 * sizes[visible]
         speed = np.hypot(self.x[:, 2], self.x[:, 3])
-        self.went = np.maximum(self.went, np.hypot(*(self.x[:, :2] - self.first).T))
+        # how far it went from where it was first seen: measured when seen (not while
+        # only predicted), and, unless it stands where the memory saw free space,
+        # beyond what more or less of it in view explains
+        rows = track_of[visible]
+        growth = np.where(new[visible] >= NEW_FRACTION, 0.0,
+                          sizes[visible] - self.first_size[rows])
+        self.went[rows] = np.maximum(self.went[rows], _displacement(
+            self.x[rows, :2] - self.first[rows], growth))
         went = np.where(self.new_age >= 0, NEW_MOVE_DISTANCE, MOVE_DISTANCE)
         # where the memory has obstacles under (most of) its points, it stands on what
         # the robot has seen stand there: it does not move, whatever its centroid does
@@ -356,9 +386,12 @@ class Tracker:
         free |= unseen & self.moved
         moving = (self.hits >= MIN_HITS) & (speed >= self.moving_speed) \
             & (self.went >= went) & free
+        point_track = track_of[labels] if count else np.zeros(0, np.int64)
+        for k in np.flatnonzero(moving):   # and it has left where it was first seen
+            moving[k] = not _still_there(self.first_points[k], points[point_track != k],
+                                         None if sigma is None else sigma[point_track != k])
         self.moved = moving.copy()
         held = moving | ((self.new_age >= 0) & (self.new_age < NEW_OBJECT_SCANS))
-        point_track = track_of[labels] if count else np.zeros(0, np.int64)
         # held[id] by track id; the last slot (id -1: a point of no track) stays False
         held_by_id = np.zeros(self._next_id + 1, bool)
         held_by_id[self.ids[held]] = True
@@ -369,6 +402,48 @@ class Tracker:
                             moving, held, point_track,
                             np.vstack(trail) if trail else np.zeros((0, 2)))
         return self._last
+
+
+def _some_points(points: NDArray[np.float64], labels: NDArray[np.int64],
+                 which: list[int]) -> NDArray[np.float64]:
+    """Up to FIRST_POINTS points (k, FIRST_POINTS, 2) [m] of each cluster in ``which``,
+    spread over it in beam order; NaN where a cluster has fewer."""
+    out = np.full((len(which), FIRST_POINTS, 2), np.nan)
+    for row, k in enumerate(which):
+        mine = points[labels == k]
+        pick = np.unique(np.linspace(0, len(mine) - 1, FIRST_POINTS).round().astype(int))
+        out[row, :len(pick)] = mine[pick]
+    return out
+
+
+def _still_there(first: NDArray[np.float64], others: NDArray[np.float64],
+                 sigma: NDArray[np.float64] | None) -> bool:
+    """Whether at least STILL_FRACTION of the points a track was first seen at
+    (``first``, (m, 2) [m], NaN: none) have a return of this scan not its own
+    (``others``, (n, 2)) within VACATED_RADIUS, or two standard deviations of that
+    return's range noise ``sigma`` (n,) if more: the place is not vacated. A wall cut
+    into a piece that slides along it as the robot drives (noise and dropped beams
+    breaking it up) is still where its track began, the rest of the wall returning
+    there; someone who walked off has left it (or hides it: behind them, it counts
+    as left), their own returns aside: a walker crossing the robot's way slides along
+    its own outline."""
+    first = first[np.isfinite(first[:, 0])]
+    if not len(others) or not len(first):
+        return False
+    reach = VACATED_RADIUS if sigma is None else np.maximum(VACATED_RADIUS, 2.0 * sigma)
+    near = np.hypot(*(first[:, None, :] - others[None, :, :]).transpose(2, 0, 1)) <= reach
+    return bool(np.count_nonzero(near.any(axis=1)) >= STILL_FRACTION * len(first))
+
+
+def _displacement(shift: NDArray[np.float64], growth: NDArray[np.float64]) -> NDArray:
+    """How far (k,) [m] clusters whose centroids are ``shift`` (k, 2) [m] from where
+    their tracks were first seen, and whose extents changed by ``growth`` (k,) [m] since,
+    have moved: a cluster that grows or shrinks as more or less of a standing object
+    comes into view (the end of a long box seen first, then its side) moves its centroid
+    by up to half that change without moving at all. (Where the cluster stands on cells
+    the memory saw free, the caller passes no growth: something walking out from behind
+    an edge grows as it comes into view, and it does move.)"""
+    return np.maximum(np.hypot(*shift.T) - 0.5 * np.abs(growth), 0.0)
 
 
 def _cluster_features(points: NDArray[np.float64], labels: NDArray[np.int64], count: int,
