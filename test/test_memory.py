@@ -15,6 +15,7 @@ from subapf_planner.core.occupancy import LOG_ODDS_MAX, OccupancyGrid
 from subapf_planner.core.planner import Planner
 from subapf_planner.core.scan import Scan
 from subapf_planner.core.status import Status
+from subapf_planner.core.tracking import FREE_LOG_ODDS
 
 pytestmark = pytest.mark.core
 
@@ -54,6 +55,36 @@ def test_open_beam_clears_up_to_its_range():
     assert grid.log_odds[tuple(grid.cell_of([1.9, 0.0])[0])] < 0.5
     assert grid.log_odds[tuple(grid.cell_of([2.2, 0.0])[0])] == 0.5
     assert grid.log_odds[tuple(grid.cell_of([0.05, 0.0])[0])] == 0.5   # within range_min
+
+
+def test_a_held_new_object_is_not_cleared_by_its_own_returns_that_fell_long():
+    """Returns held out of the memory mark nothing. Those of something held because it
+    is new (NavigationMemory.integrate's ``unmoved``) clear their rays only up to two
+    standard deviations of their range noise before them (``transient_short``): a box
+    standing 1.5 m ahead, held while it is new, whose returns through the LDS-01's
+    noise fall long as often as short, is not cleared from under itself (it stayed new
+    and, its visible side changing, seemed to move, held for ever). A mover's returns
+    clear up to themselves (else its trail stays), and clear the box's cells."""
+    def after(short: float) -> float:
+        grid = OccupancyGrid(RES, 10.0)
+        rng = np.random.default_rng(4)
+        for _ in range(20):   # 3.75 cm of noise at 1.5 m
+            grid.update(Scan([1.5 + rng.normal(0.0, 0.0375)], 0.0, 0.01, 0.12, 3.5),
+                        (0.0, 0.0, 0.0), transient=np.array([True]), transient_short=short)
+        for x in (0.5, 1.0):   # the way to it is cleared either way
+            assert grid.log_odds[tuple(grid.cell_of([x, 0.0])[0])] < 0.0
+        return float(grid.log_odds[tuple(grid.cell_of([1.5, 0.0])[0])])
+    assert after(2.0 * 0.0375) == 0.0   # never seen through: unknown, as it was
+    assert after(0.0) < FREE_LOG_ODDS   # seen free (tracking): where the box stands
+    for unmoved, before_it in ((True, 0.0), (False, -1.0)):   # new / moving
+        memory = NavigationMemory(PlannerConfig(laser_x=0.0, laser_y=0.0, laser_yaw=0.0))
+        scan = Scan(np.full(360, 1.5), 0.0, math.radians(1.0), 0.12, 3.5, 1.0)
+        memory.integrate(scan, (0.0, 0.0, 0.0), None, np.ones(360, bool),
+                         np.full(360, unmoved))
+        at = {x: memory.grid.log_odds[tuple(memory.grid.cell_of([x, 0.0])[0])]
+              for x in (1.0, 1.45)}
+        assert memory.grid.log_odds.max() <= 0.0 and at[1.0] < 0.0
+        assert np.sign(at[1.45]) == before_it, (unmoved, at)
 
 
 def test_an_obstacle_seen_then_seen_through_is_forgotten():

@@ -36,7 +36,7 @@ from .known_map import KnownMap
 from .navigation import NavigationField, compute_field, nearest_free
 from .occupancy import ESTABLISHED, NOT_ESTABLISHED, OccupancyGrid
 from .robot import compose, to_parent
-from .scan import Scan, scans_in
+from .scan import Scan, range_sigma, scans_in
 from .tracking import clusters
 
 #: Goals closer than this are the same goal (the field's, the controller's) [m].
@@ -248,16 +248,24 @@ class NavigationMemory:
         return (tuple(np.round(goal / SAME_GOAL).astype(int)), self.grid.version)
 
     def integrate(self, scan: Scan, scan_pose: ArrayLike, goal: ArrayLike | None = None,
-                  transient: NDArray[np.bool_] | None = None) -> bool:
+                  transient: NDArray[np.bool_] | None = None,
+                  unmoved: NDArray[np.bool_] | None = None) -> bool:
         """Add a scan taken with base_footprint at ``scan_pose`` unless the scan with its
         stamp was added already (a NaN stamp is always new); ``transient`` marks the beams
-        that returned from something moving (OccupancyGrid.update)."""
+        that returned from something held out of the memory (OccupancyGrid.update), and
+        ``unmoved`` those of them held because it is new, not because it moves: their
+        beams clear only up to two standard deviations of their range noise before the
+        return (a standing object held while it is new is not cleared from under itself
+        by its returns that fell long; a mover's clear up to it, or its trail stays)."""
         if self._scan_stamp is not None and scan.stamp == self._scan_stamp:
             return False
         self._scan_stamp = scan.stamp
         self.grid.follow(scan_pose, goal)
+        short = 0.0 if unmoved is None else np.where(unmoved, 2.0 * range_sigma(
+            np.nan_to_num(scan.ranges, posinf=0.0), self.cfg.range_noise_floor,
+            self.cfg.range_noise_fraction), 0.0)
         self.grid.update(scan, compose(scan_pose, self.cfg.laser_mount), self.cfg.obstacle_range,
-                         transient)
+                         transient, short)
         return True
 
     def align(self, base: ArrayLike, predicted: ArrayLike,

@@ -208,12 +208,15 @@ class OccupancyGrid:
 
     # --- scans ------------------------------------------------------------------------
     def update(self, scan: Scan, laser_pose: ArrayLike, clear_range: float = math.inf,
-               transient: NDArray[np.bool_] | None = None) -> None:
+               transient: NDArray[np.bool_] | None = None,
+               transient_short: ArrayLike = 0.0) -> None:
         """Integrate one scan taken with the laser at ``laser_pose`` (x, y, yaw) in odom
         (see the module docstring for the rule). Its geometry is assumed checked
         (Scan.check: the planner refuses a bad scan before this is called).
-        ``transient`` (per beam): returns of something moving; their beams clear the
-        cells they cross but their end cells are not marked (core/tracking.py)."""
+        ``transient`` (per beam): returns of something moving or new (held out of the
+        memory: core/tracking.py); their beams clear the cells they cross but their end
+        cells are not marked, and they stop clearing ``transient_short`` [m] (per beam,
+        or one for all) before the return."""
         self.scans += 1
         r = np.asarray(scan.ranges, float).ravel()
         lx, ly, lyaw = (float(v) for v in laser_pose)
@@ -234,6 +237,9 @@ class OccupancyGrid:
         # a return so its own cell is not cleared; built ragged (only the samples a beam
         # has)
         stop = np.where(ends_hit, length - 0.5 * res, length)
+        if transient is not None:
+            short = np.broadcast_to(np.asarray(transient_short, float), r.shape)[use]
+            stop = np.where(ends_hit & transient[use], stop - short, stop)
         first = max(math.ceil(scan.range_min / res - 0.5), 0)
         counts = np.maximum(np.ceil(stop / res - 0.5) - first, 0).astype(np.int64)
         beam = np.repeat(np.arange(a.size), counts)

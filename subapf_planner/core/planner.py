@@ -76,6 +76,9 @@ class Perception:
     goal: NDArray[np.float64]
     #: Per beam: whether it returned from something moving (None: no tracker).
     transient: NDArray[np.bool_] | None
+    #: Per beam: whether it returned from something held out of the memory because it
+    #: is new, not because it moves (None: no tracker).
+    unmoved: NDArray[np.bool_] | None
     #: Where what moves was in the last scans (k, 2) [m]: cleared in the memory.
     trail: NDArray[np.float64]
 
@@ -236,7 +239,7 @@ class Planner:
         except ScanError:
             return self._stop(PlanResult(Command(0.0, 0.0, Status.INVALID_SCAN)))
         points = to_parent(scan_pose, base)   # the returns in base_footprint, then placed
-        tracks, transient = self._track(scan, points, scan_pose, now)
+        tracks, transient, unmoved = self._track(scan, points, scan_pose, now)
         if cfg.geodesic:   # the memory takes the scan in once the command is out
             seen, seen_base = scan, base
             if memory_scan is not None and memory_scan is not scan \
@@ -245,8 +248,9 @@ class Planner:
                 seen_base = scan_to_points(seen, (0.0, 0.0, 0.0), cfg.laser_mount,
                                            cfg.obstacle_range)
                 transient = on_grid(transient, scan, seen)
+                unmoved = on_grid(unmoved, scan, seen)
             self._perception = Perception(seen, seen_base, odom_scan_pose, goal, transient,
-                                          tracks.trail)
+                                          unmoved, tracks.trail)
         obstacles = points
         if cfg.geodesic:   # what the lidar cannot see now, the memory remembers
             blind = blind_obstacles(self.memory.grid, pose, compose(scan_pose, cfg.laser_mount),
@@ -302,7 +306,8 @@ class Planner:
             self._align(seen.scan, seen.base, seen.scan_pose)
         if len(seen.trail):
             self.memory.clear(seen.trail)
-        self.memory.integrate(seen.scan, self.in_map(seen.scan_pose), seen.goal, seen.transient)
+        self.memory.integrate(seen.scan, self.in_map(seen.scan_pose), seen.goal, seen.transient,
+                              seen.unmoved)
 
     def in_map(self, pose: ArrayLike) -> NDArray[np.float64]:
         """An odom pose (x, y, yaw) in the memory's frame (odom corrected by the scan
@@ -417,15 +422,17 @@ class Planner:
         return self._goal[1]
 
     def _track(self, scan: Scan, points: NDArray, scan_pose: NDArray,
-               now: float) -> tuple[Tracks, NDArray[np.bool_] | None]:
+               now: float) -> tuple[Tracks, NDArray[np.bool_] | None,
+                                    NDArray[np.bool_] | None]:
         """The tracks of this scan (its returns ``points`` in the memory's frame, taken
-        at ``scan_pose``), and per beam whether it returned from a moving one. The
+        at ``scan_pose``), per beam whether it returned from one held out of the memory
+        (moving or new), and whether from one held because it is new, not moving. The
         tracker is told which returns are on what has stood for STANDING_TIME,
         within two standard deviations of their range noise along their rays
         (NavigationMemory.standing)."""
         t = scan.stamp if math.isfinite(scan.stamp) else now
         if not self.cfg.tracks_moving or not math.isfinite(t):
-            return NO_TRACKS, None
+            return NO_TRACKS, None, None
         origin = compose(scan_pose, self.cfg.laser_mount)[:2]
         noise = range_sigma(np.hypot(*(points - origin).T), self.cfg.range_noise_floor,
                             self.cfg.range_noise_fraction)
@@ -437,7 +444,9 @@ class Planner:
                                      beams * scan.beam_interval, noise)
         transient = np.zeros(np.size(scan.ranges), bool)
         transient[beams] = tracks.held_points
-        return tracks, transient
+        unmoved = np.zeros(np.size(scan.ranges), bool)
+        unmoved[beams] = tracks.unmoved_points
+        return tracks, transient, unmoved
 
     def _stop(self, result: PlanResult) -> PlanResult:
         self.reset()

@@ -163,6 +163,12 @@ class Tracks:
         """Per scan point: it belongs to a moving track."""
         return self._of_points(self.moving)
 
+    @property
+    def unmoved_points(self) -> NDArray[np.bool_]:
+        """Per scan point: it belongs to a track held out of the memory because it is
+        new, not because it moves."""
+        return self._of_points(self.held & ~self.moving)
+
     def ahead(self, dt: float) -> Tracks:
         """The tracks ``dt`` [s] later: each where its velocity takes it (a scan is some
         tenths of a second old when it is planned with: the sweep, the driver's latency,
