@@ -21,7 +21,7 @@ from subapf_planner.core.evasion import (
 from subapf_planner.core.planner import Planner
 from subapf_planner.core.rollout import rollouts
 from subapf_planner.core.scan import Scan
-from subapf_planner.core.tracking import Tracker, Tracks, _displacement
+from subapf_planner.core.tracking import Tracker, Tracks
 
 pytestmark = pytest.mark.core
 
@@ -155,40 +155,6 @@ def test_a_cluster_on_what_has_long_stood_never_moves_whatever_its_centroid_does
     assert not moved_when(True)
 
 
-def noisy_line(a, b, spacing, sigma, rng):
-    """Returns along the segment ``a`` -> ``b`` every ``spacing`` [m], each moved across
-    it by range noise of ``sigma`` [m] (a wall or a box side through a real lidar: too
-    rough for the straight-piece rule)."""
-    a, b = np.asarray(a, float), np.asarray(b, float)
-    n = max(int(round(np.hypot(*(b - a)) / spacing)) + 1, 2)
-    along = a + np.linspace(0.0, 1.0, n)[:, None] * (b - a)
-    normal = np.array([-(b - a)[1], (b - a)[0]]) / np.hypot(*(b - a))
-    return along + rng.normal(0.0, sigma, (n, 1)) * normal
-
-
-def test_a_box_whose_visible_side_grows_into_view_does_not_move():
-    """A 0.9 m box seen end first, then more of its side each scan (the robot driving
-    round it): its cluster grows from 0.1 to 0.9 m and its centroid slides 0.4 m at 0.4
-    m/s. It does not move: the centroid moved no more than half the growth explains
-    (tracking._displacement). The same cluster sliding 0.4 m without growing, its
-    first place left empty, is a mover."""
-    rng = np.random.default_rng(2)
-    grows, slides = Tracker(0.15, 1.2, 0.6, 0.04), Tracker(0.15, 1.2, 0.6, 0.04)
-    ever = [False, False]
-    for k in range(12):
-        length = min(0.1 + 0.1 * k, 0.9)
-        a = grows.update(noisy_line((2.0, 0.0), (2.0 + length, 0.0), 0.03, 0.03, rng),
-                         0.2 * k, np.zeros(int(round(length / 0.03)) + 1))
-        shift = min(0.1 * k, 0.5)
-        pts = noisy_line((2.0 + shift, 0.0), (2.4 + shift, 0.0), 0.03, 0.03, rng)
-        b = slides.update(pts, 0.2 * k, np.zeros(len(pts)))
-        ever = [ever[0] or bool(a.moving.any()), ever[1] or bool(b.moving.any())]
-    assert len(a.position) == 1 and ever == [False, True]
-    # half the growth explains the centroid's shift, none of a shift beyond it
-    assert _displacement(np.array([[0.4, 0.0]]), np.array([0.8]))[0] == 0.0
-    assert _displacement(np.array([[0.4, 0.0]]), np.array([0.0]))[0] == pytest.approx(0.4)
-
-
 def scans_with_a_mover_beside_a_wall(seed: int) -> int:
     """Of 50 scans a robot takes driving 2.2 m at 0.22 m/s along a wall 2.7 m beside it,
     through the LDS-01's noise (2.5 % of the range: 7-9 cm at the wall) with a fifth of
@@ -217,10 +183,10 @@ def scans_with_a_mover_beside_a_wall(seed: int) -> int:
 
 def test_a_wall_beside_the_robot_through_a_noisy_lidar_has_no_mover(monkeypatch):
     """Driving past a wall through a realistic lidar (scans_with_a_mover_beside_a_wall,
-    8 runs, 400 scans): at most 3 % of the scans have a moving track (measured: none),
-    as the pieces of the wall that slide along it are still where their tracks began
+    8 runs, 400 scans): at most 3 % of the scans have a moving track (measured: 5), as
+    the pieces of the wall that slide along it are still where their tracks began
     (tracking._still_there: the rest of the wall returns there). Without that rule,
-    over 10 % (measured: 86)."""
+    over 10 % (measured: 108)."""
     from subapf_planner.core import tracking
     ghosts = sum(scans_with_a_mover_beside_a_wall(seed) for seed in range(8))
     monkeypatch.setattr(tracking, '_still_there', lambda first, others, sigma: False)

@@ -23,14 +23,12 @@ A track **moves** when it has been seen MIN_HITS times, its estimated speed is
 at least ``moving_speed``, it has been MOVE_DISTANCE from where it was first seen
 at some time (NEW_MOVE_DISTANCE if it was new then: standing on cells the memory
 had seen free; someone walking to and fro stays a mover), and it has left that
-place. How far it went is measured at the scans it is seen (not from predictions),
-less half the change of its cluster's extent (more or less of a standing object in
-view moves a centroid that much; not where the cluster stands on cells seen free:
-something walking out from behind an edge grows into view); and it has left the place
-when fewer than STILL_FRACTION of the points it was first seen at have a return
-within VACATED_RADIUS (or two standard deviations of the return's range noise):
-a piece of a long wall that noise and dropped beams cut out of it, sliding along
-it as the robot drives, is still where it began. It is
+place. How far it went is measured at the scans it is seen (not from predictions);
+it has left the place when fewer than STILL_FRACTION of the points it was first seen
+at have a return of another cluster within VACATED_RADIUS (or two standard
+deviations of the return's range noise): a piece of a long wall that noise and
+dropped beams cut out of it, sliding along it as the robot drives, is still where it
+began, the rest of the wall returning there. It is
 **held** out of the occupancy memory while it moves, and while its cluster is new
 and stands mostly on cells the memory has seen free (something new where there
 was nothing: held NEW_OBJECT_SCANS scans, then written if it did not move).
@@ -225,7 +223,7 @@ class Tracker:
 
     #: Per-track arrays, one row per track, appended and filtered together.
     PER_TRACK = ('x', 'P', 'hits', 'misses', 'new_age', 'radius', 'ids', 'first',
-                 'first_size', 'first_points', 'went', 'moved')
+                 'first_points', 'went', 'moved')
 
     def __init__(self, gap: float, max_size: float, gate: float, moving_speed: float) -> None:
         self.gap, self.max_size, self.gate, self.moving_speed = gap, max_size, gate, moving_speed
@@ -241,7 +239,6 @@ class Tracker:
         self.radius = np.zeros(0)
         self.ids = np.zeros(0, np.int64)
         self.first = np.zeros((0, 2))   # where each track was first seen [m]
-        self.first_size = np.zeros(0)    # its cluster's extent then [m]
         # (n, FIRST_POINTS, 2) [m]: its cluster's points then (NaN: none)
         self.first_points = np.zeros((0, FIRST_POINTS, 2))
         self.went = np.zeros(0)          # the farthest it has been from there [m]
@@ -359,8 +356,8 @@ class Tracker:
                          misses=np.zeros(m, np.int64),
                          new_age=np.where(new[fresh] >= NEW_FRACTION, 0, -1).astype(np.int64),
                          radius=np.zeros(m), ids=self._next_id + np.arange(m),
-                         first=cents[fresh], first_size=sizes[fresh],
-                         first_points=_some_points(points, labels, fresh), went=np.zeros(m),
+                         first=cents[fresh], first_points=_some_points(points, labels, fresh),
+                         went=np.zeros(m),
                          moved=np.zeros(m, bool))
             self._next_id += m
         keep = self.misses <= MAX_MISSES
@@ -371,14 +368,11 @@ class Tracker:
         visible = track_of >= 0
         self.radius[track_of[visible]] = 0.5 * sizes[visible]
         speed = np.hypot(self.x[:, 2], self.x[:, 3])
-        # how far it went from where it was first seen: measured when seen (not while
-        # only predicted), and, unless it stands where the memory saw free space,
-        # beyond what more or less of it in view explains
+        # how far it went from where it was first seen: measured when seen (a lost scan's
+        # prediction is not a motion seen)
         rows = track_of[visible]
-        growth = np.where(new[visible] >= NEW_FRACTION, 0.0,
-                          sizes[visible] - self.first_size[rows])
-        self.went[rows] = np.maximum(self.went[rows], _displacement(
-            self.x[rows, :2] - self.first[rows], growth))
+        self.went[rows] = np.maximum(self.went[rows],
+                                     np.hypot(*(self.x[rows, :2] - self.first[rows]).T))
         went = np.where(self.new_age >= 0, NEW_MOVE_DISTANCE, MOVE_DISTANCE)
         # where the memory has obstacles under (most of) its points, it stands on what
         # the robot has seen stand there: it does not move, whatever its centroid does
@@ -439,17 +433,6 @@ def _still_there(first: NDArray[np.float64], others: NDArray[np.float64],
     reach = VACATED_RADIUS if sigma is None else np.maximum(VACATED_RADIUS, 2.0 * sigma)
     near = np.hypot(*(first[:, None, :] - others[None, :, :]).transpose(2, 0, 1)) <= reach
     return bool(np.count_nonzero(near.any(axis=1)) >= STILL_FRACTION * len(first))
-
-
-def _displacement(shift: NDArray[np.float64], growth: NDArray[np.float64]) -> NDArray:
-    """How far (k,) [m] clusters whose centroids are ``shift`` (k, 2) [m] from where
-    their tracks were first seen, and whose extents changed by ``growth`` (k,) [m] since,
-    have moved: a cluster that grows or shrinks as more or less of a standing object
-    comes into view (the end of a long box seen first, then its side) moves its centroid
-    by up to half that change without moving at all. (Where the cluster stands on cells
-    the memory saw free, the caller passes no growth: something walking out from behind
-    an edge grows as it comes into view, and it does move.)"""
-    return np.maximum(np.hypot(*shift.T) - 0.5 * np.abs(growth), 0.0)
 
 
 def _cluster_features(points: NDArray[np.float64], labels: NDArray[np.int64], count: int,
