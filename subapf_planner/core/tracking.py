@@ -86,9 +86,9 @@ NEW_MOVE_DISTANCE = 0.15
 #: Points of a cluster kept from when its track was first seen ...
 FIRST_POINTS = 12
 #: ... and a track moves only once fewer than STILL_FRACTION of them have a return of
-#: the scan within VACATED_RADIUS [m] (or two standard deviations of that return's range
-#: noise): something that moves leaves the place it was first seen at, a piece of wall
-#: or clutter whose centroid only seems to move does not (tracking._still_there).
+#: another cluster within VACATED_RADIUS [m] (or two standard deviations of that return's
+#: range noise): something that moves leaves the place it was first seen at, a piece of
+#: wall whose centroid only seems to move does not (tracking._still_there).
 STILL_FRACTION = 0.5
 VACATED_RADIUS = 0.1
 #: A cluster whose points lie this close to a line [m] (the smaller principal standard
@@ -299,8 +299,8 @@ class Tracker:
         STANDING_TIME (n,; none when not given) and how long after ``t`` each was
         taken (n, [s]; a spinning lidar's beam i is i * time_increment after the first:
         a walker seen late in the sweep is measured where it was then; none: all at
-        ``t``) and each one's range noise (n, [m]; none: 0), before the scan is
-        written; returns the tracks, at time ``t``.
+        ``t``) and each one's range noise (n, [m]; none: VACATED_RADIUS alone), before
+        the scan is written; returns the tracks, at time ``t``.
         A scan at the same time as the last is not taken again (the tracks stand)."""
         if self.time is not None and t == self.time and self._last is not None:
             return self._last   # the same scan again (a tick without a new one)
