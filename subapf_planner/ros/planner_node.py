@@ -48,7 +48,7 @@ from sensor_msgs.msg import LaserScan, TimeReference
 from std_msgs.msg import Header, String
 from visualization_msgs.msg import MarkerArray
 
-from ..bag.events import stamp_ns
+from ..bag.events import TAKEN_SOURCE, stamp_ns
 from ..core.config import (
     ConfigError,
     PlannerConfig,
@@ -214,9 +214,10 @@ class PlannerParts:
         polled = PolledGroup()
         self._inputs = (
             (self._subscription(LaserScan, 'scan', self._on_scan, qos_profile_sensor_data,
-                                callback_group=polled), self._on_scan, 'scan'),
+                                callback_group=polled), self._on_scan, TAKEN_SOURCE['scan']),
             (self._subscription(Odometry, 'odom', self._on_odom, QoSProfile(depth=ODOM_QUEUE),
-                                callback_group=polled), self._on_odom, 'odom'))
+                                callback_group=polled), self._on_odom,
+             TAKEN_SOURCE['odom']))
         self._subscription(PoseStamped, 'goal_pose', self._on_goal, 10)
         self._silence_checked = -float('inf')   # when the silent inputs were looked at
         self._unheard: set[bytes] = set()   # publishers warned about (endpoint GIDs)
@@ -455,7 +456,7 @@ class PlannerParts:
         if not self.active:
             self.get_logger().warn('goal_pose ignored: the planner is not active')
             return
-        self._taken.append(('goal_pose', msg.header.stamp))
+        self._taken.append((TAKEN_SOURCE['goal'], msg.header.stamp))
         if self.take_goal(msg) is None and self.actions is not None:
             self.actions.preempt('preempted by a goal on goal_pose')
 
