@@ -11,7 +11,7 @@ import pytest
 from subapf_planner.core.config import PlannerConfig
 from subapf_planner.core.memory import NavigationMemory
 from subapf_planner.core.navigation import NEIGHBOURS, compute_field, densify, thin_polyline
-from subapf_planner.core.occupancy import LOG_ODDS_MAX, OccupancyGrid
+from subapf_planner.core.occupancy import ESTABLISHED, LOG_ODDS_MAX, OccupancyGrid
 from subapf_planner.core.planner import Planner
 from subapf_planner.core.scan import Scan
 from subapf_planner.core.status import Status
@@ -87,6 +87,27 @@ def test_a_held_new_object_is_not_cleared_by_its_own_returns_that_fell_long():
         assert np.sign(at[1.45]) == before_it, (unmoved, at)
 
 
+def test_a_wall_is_drawn_where_its_noisy_returns_are_not_behind_them():
+    """A wall 1.5 m ahead seen through the LDS-01's noise (3.75 cm there). In the planning
+    layer each return that fell long clears the cells in front of it: the cell of the
+    wall's face (1.45-1.50 m) is cleared as often as marked and never established, and
+    the wall is drawn from the cell behind it. In the walls' layer the alignment matches
+    to (``wall_odds``) a beam clears only up to two standard deviations before its
+    return, and the face's cell is established."""
+    grid = OccupancyGrid(RES, 10.0, hit_places=True)
+    rng = np.random.default_rng(7)
+    for _ in range(200):
+        grid.update(Scan([1.5 + rng.normal(0.0, 0.0375)], 0.0, 0.01, 0.12, 3.5),
+                    (0.0, 0.0, 0.0), wall_short=2.0 * 0.0375)
+    face, behind = (tuple(grid.cell_of([x, 0.0])[0]) for x in (1.475, 1.525))
+    assert grid.wall_odds[face] >= ESTABLISHED > grid.log_odds[face]
+    assert grid.wall_odds[behind] >= ESTABLISHED and grid.log_odds[behind] >= ESTABLISHED
+    for x in (0.5, 1.0, 1.4):   # the way to it is cleared in both
+        cell = tuple(grid.cell_of([x, 0.0])[0])
+        assert grid.log_odds[cell] < 0.0 and grid.wall_odds[cell] < 0.0
+    assert OccupancyGrid(RES, 10.0).wall_odds is None   # kept for the alignment only
+
+
 def test_an_obstacle_seen_then_seen_through_is_forgotten():
     grid = OccupancyGrid(RES, 10.0)
     for _ in range(20):
@@ -111,7 +132,7 @@ def test_memory_stays_bounded_on_a_long_drive():
         robot = grid.cell_of([x, 0.0])[0]
         assert grid.inside(robot[None])[0]
     assert grid.nbytes == size == 400 * 400 * 4   # log odds (no scan alignment)
-    assert OccupancyGrid(0.05, 20.0, hit_places=True).nbytes == 400 * 400 * (4 + 8 + 2 + 4)
+    assert OccupancyGrid(0.05, 20.0, hit_places=True).nbytes == 400 * 400 * (4 + 8 + 2 + 4 + 4)
     # only what is near the robot is remembered
     assert grid.centre_of(np.argwhere(grid.occupied()))[:, 0].min() > 200.0 - 20.0
 

@@ -46,6 +46,10 @@ SAME_GOAL = 1e-3
 DISTANCE_FIELD_SCANS = 5
 #: ... and covers this much around the scan that made it [m].
 DISTANCE_FIELD_MARGIN = 1.0
+#: A return may have fallen long by this many standard deviations of its range noise:
+#: its beam clears the walls' layer (and, held while new, the planning layer) only up
+#: to this before it (NavigationMemory.integrate).
+NOISE_BAND = 2.0
 #: Returns this far beyond a moving track's disc are the alignment's again [m].
 MOVING_MARGIN = 0.3
 #: The route a field favours is its descent this far from the robot [m] (beyond the
@@ -254,18 +258,26 @@ class NavigationMemory:
         stamp was added already (a NaN stamp is always new); ``transient`` marks the beams
         that returned from something held out of the memory (OccupancyGrid.update), and
         ``unmoved`` those of them held because it is new, not because it moves: their
-        beams clear only up to two standard deviations of their range noise before the
-        return (a standing object held while it is new is not cleared from under itself
-        by its returns that fell long; a mover's clear up to it, or its trail stays)."""
+        beams clear only up to NOISE_BAND standard deviations of their range noise before
+        the return (a standing object held while it is new is not cleared from under
+        itself by its returns that fell long; a mover's clear up to it, or its trail
+        stays). In the walls' layer the alignment matches to, every beam but a mover's
+        clears only up to that band (core/occupancy.py: a wall is not drawn behind
+        itself)."""
         if self._scan_stamp is not None and scan.stamp == self._scan_stamp:
             return False
         self._scan_stamp = scan.stamp
         self.grid.follow(scan_pose, goal)
-        short = 0.0 if unmoved is None else np.where(unmoved, 2.0 * range_sigma(
-            np.nan_to_num(scan.ranges, posinf=0.0), self.cfg.range_noise_floor,
-            self.cfg.range_noise_fraction), 0.0)
+        band = NOISE_BAND * range_sigma(np.nan_to_num(scan.ranges, posinf=0.0),
+                                        self.cfg.range_noise_floor,
+                                        self.cfg.range_noise_fraction)
+        short = 0.0 if unmoved is None else np.where(unmoved, band, 0.0)
+        wall_short = band
+        if transient is not None:   # a mover's beams clear up to it
+            moves = transient if unmoved is None else transient & ~unmoved
+            wall_short = np.where(moves, 0.0, band)
         self.grid.update(scan, compose(scan_pose, self.cfg.laser_mount), self.cfg.obstacle_range,
-                         transient, short)
+                         transient, short, wall_short)
         return True
 
     def align(self, base: ArrayLike, predicted: ArrayLike,
@@ -295,7 +307,8 @@ class NavigationMemory:
             here.min(axis=0) < f.origin) or np.any(here.max(axis=0) > reach)
         if stale:
             g = self.grid
-            self._distance = distance_field(g.log_odds, g.origin, g.resolution, here,
+            walls = g.log_odds if g.wall_odds is None else g.wall_odds
+            self._distance = distance_field(walls, g.origin, g.resolution, here,
                                             DISTANCE_FIELD_MARGIN, g.hit_offset,
                                             g.established_at, g.scans,
                                             scans_in(MIN_WALL_AGE, self.cfg.period),

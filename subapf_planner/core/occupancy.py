@@ -16,6 +16,14 @@ Update rule, per beam of a scan taken at the laser's odom pose:
 * NaN, 0.0, negative and below-range_min returns are not evidence of anything
   (LDS-01 and LDS-02 invalid beams) and change nothing.
 
+With hit places kept (the scan alignment's), a second layer of log odds holds the
+walls the alignment matches to: the same rule, but a beam clears only up to what the
+caller says its range noise may have made it fall short by. A wall whose returns
+that fell long clear the cells in front of it, and nothing clears those behind it,
+is drawn behind itself: matches to it lean away from it, scan after scan. The
+planning layer is cleared up to each return, so that what the robot may drive
+through is not narrowed by the noise.
+
 Log odds are clamped to [LOG_ODDS_MIN, LOG_ODDS_MAX], so a wall seen many
 times stays after a few dropped beams, and a thing that moved away is
 forgotten after a few scans through it. A cell is occupied when its log odds
@@ -90,6 +98,11 @@ class OccupancyGrid:
         #: not (core/alignment.py).
         self.established_at: NDArray[np.int32] | None = \
             np.full((n, n), NOT_ESTABLISHED, np.int32) if hit_places else None
+        #: With ``hit_places``: the log odds of the scan alignment's walls, marked as
+        #: ``log_odds`` but cleared by each beam only up to ``wall_short`` before its
+        #: return (OccupancyGrid.update; see the module docstring).
+        self.wall_odds: NDArray[np.float32] | None = \
+            np.zeros((n, n), np.float32) if hit_places else None
         #: Scans integrated so far.
         self.scans = 0
         self.origin = np.array([-0.5, -0.5]) * self.cells * self.resolution
@@ -107,7 +120,8 @@ class OccupancyGrid:
     @property
     def nbytes(self) -> int:
         """Memory held by the grid [bytes]."""
-        layers = (self.log_odds, self.hit_offset, self.hit_count, self.established_at)
+        layers = (self.log_odds, self.hit_offset, self.hit_count, self.established_at,
+                  self.wall_odds)
         return int(sum(a.nbytes for a in layers if a is not None))
 
     def cell_of(self, points: ArrayLike) -> NDArray[np.int64]:
@@ -130,6 +144,7 @@ class OccupancyGrid:
             self.log_odds[cells[hit, 0], cells[hit, 1]] = 0.0
             if self.established_at is not None:
                 self.established_at[cells[hit, 0], cells[hit, 1]] = NOT_ESTABLISHED
+                self.wall_odds[cells[hit, 0], cells[hit, 1]] = 0.0
             self.version += 1
 
     def know(self, known: KnownMap | None) -> None:
@@ -147,6 +162,7 @@ class OccupancyGrid:
         values, wall = prior(self.known, self.centre_of(np.column_stack((rows, cols))))
         self.log_odds[rows, cols] = values
         if self.hit_offset is not None:
+            self.wall_odds[rows, cols] = values
             self.hit_offset[rows, cols] = 0.0
             self.hit_count[rows, cols] = 0
             self.established_at[rows, cols] = NOT_ESTABLISHED
@@ -184,7 +200,8 @@ class OccupancyGrid:
         n = self.cells
         dx, dy = int(d[0]), int(d[1])
         layers = []
-        for a in (self.log_odds, self.hit_offset, self.hit_count, self.established_at):
+        for a in (self.log_odds, self.hit_offset, self.hit_count, self.established_at,
+                  self.wall_odds):
             if a is None:   # no hit places kept
                 layers.append(a)
                 continue
@@ -197,7 +214,8 @@ class OccupancyGrid:
                 dst_c = slice(max(-dx, 0), n + min(-dx, 0))
                 shifted[dst_r, dst_c] = a[src_r, src_c]
             layers.append(shifted)
-        self.log_odds, self.hit_offset, self.hit_count, self.established_at = layers
+        (self.log_odds, self.hit_offset, self.hit_count, self.established_at,
+         self.wall_odds) = layers
         self.origin = new_origin
         self.version += 1
         if self.known is not None:   # the cells that came in start from the known map
@@ -209,14 +227,16 @@ class OccupancyGrid:
     # --- scans ------------------------------------------------------------------------
     def update(self, scan: Scan, laser_pose: ArrayLike, clear_range: float = math.inf,
                transient: NDArray[np.bool_] | None = None,
-               transient_short: ArrayLike = 0.0) -> None:
+               transient_short: ArrayLike = 0.0, wall_short: ArrayLike = 0.0) -> None:
         """Integrate one scan taken with the laser at ``laser_pose`` (x, y, yaw) in odom
         (see the module docstring for the rule). Its geometry is assumed checked
         (Scan.check: the planner refuses a bad scan before this is called).
         ``transient`` (per beam): returns of something moving or new (held out of the
         memory: core/tracking.py); their beams clear the cells they cross but their end
         cells are not marked, and they stop clearing ``transient_short`` [m] (per beam,
-        or one for all) before the return."""
+        or one for all) before the return. In the walls' layer (``wall_odds``) every beam
+        with a return stops clearing ``wall_short`` [m] (per beam, or one for all) before
+        it, or where it stops in the planning layer if that is sooner."""
         self.scans += 1
         r = np.asarray(scan.ranges, float).ravel()
         lx, ly, lyaw = (float(v) for v in laser_pose)
@@ -260,31 +280,49 @@ class OccupancyGrid:
         y0 = (ly - self.origin[1]) / res - r0
         c, s = np.cos(a), np.sin(a)
         free = self._flat(x0 + c[beam] * k, y0 + s[beam] * k, box)
+        if self.wall_odds is not None:   # the walls' layer: stops ``wall_short`` before
+            wall_stop = np.where(ends_hit, np.minimum(stop, length - np.broadcast_to(
+                np.asarray(wall_short, float), r.shape)[use]), stop)
+            keep = k < wall_stop[beam] / res
+            wall_free = self._flat(x0 + c[beam[keep]] * k[keep],
+                                   y0 + s[beam[keep]] * k[keep], box)
         end_cols = x0 + c[marked] * length[marked] / res
         end_rows = y0 + s[marked] * length[marked] / res
         ends = self._flat(end_cols, end_rows, box)
         if self.hit_offset is not None:
             self._note_hits(end_cols, end_rows, box)
-        # each touched cell changes once however many beams touch it; a return wins
-        mark = np.zeros((r1 - r0) * (c1 - c0), np.int8)
-        mark[free] = 1
-        mark[ends] = 2
-        touched = np.flatnonzero(mark)
-        w = c1 - c0   # box flat index -> the window's (C-contiguous) flat index
-        cells = touched + (touched // w) * (n - w) + (r0 * n + c0)
-        log_odds = self.log_odds.reshape(-1)   # a view: allocated C-contiguous, kept so
-        old = log_odds[cells]
-        new = np.minimum(np.maximum(
-            old + np.where(mark[touched] == 2, np.float32(HIT), np.float32(MISS)),
-            np.float32(LOG_ODDS_MIN)), np.float32(LOG_ODDS_MAX))
-        log_odds[cells] = new
+        cells, old, new = self._fold(self.log_odds, free, ends, box)
+        if self.wall_odds is not None:
+            self._fold(self.wall_odds, wall_free, ends, box)
         if self.established_at is not None:
-            since = self.established_at.reshape(-1)   # a view, as log_odds
+            since = self.established_at.reshape(-1)   # a view (C-contiguous)
             first = (new >= ESTABLISHED) & (since[cells] == NOT_ESTABLISHED)
             since[cells[first]] = self.scans
             since[cells[new <= 0.0]] = NOT_ESTABLISHED
         if np.any((old > 0.0) != (new > 0.0)):
             self.version += 1
+
+    def _fold(self, layer: NDArray[np.float32], free: NDArray[np.int64],
+              ends: NDArray[np.int64], box: tuple[int, int, int, int, bool]
+              ) -> tuple[NDArray[np.int64], NDArray[np.float32], NDArray[np.float32]]:
+        """Add MISS to the log odds of ``layer``'s cells at box flat indices ``free`` and
+        HIT to those at ``ends``: each touched cell changes once however many beams touch
+        it, and a return wins. The touched cells' flat indices in the window, and their
+        log odds before and after."""
+        r0, r1, c0, c1, _ = box
+        mark = np.zeros((r1 - r0) * (c1 - c0), np.int8)
+        mark[free] = 1
+        mark[ends] = 2
+        touched = np.flatnonzero(mark)
+        n, w = self.cells, c1 - c0   # box flat index -> the window's flat index
+        cells = touched + (touched // w) * (n - w) + (r0 * n + c0)
+        flat = layer.reshape(-1)   # a view: every layer is allocated C-contiguous, kept so
+        old = flat[cells]
+        new = np.minimum(np.maximum(
+            old + np.where(mark[touched] == 2, np.float32(HIT), np.float32(MISS)),
+            np.float32(LOG_ODDS_MIN)), np.float32(LOG_ODDS_MAX))
+        flat[cells] = new
+        return cells, old, new
 
     def _note_hits(self, cols: NDArray[np.float64], rows: NDArray[np.float64],
                    box: tuple[int, int, int, int, bool]) -> None:
