@@ -307,6 +307,8 @@ class NavigationMemory:
             here.min(axis=0) < f.origin) or np.any(here.max(axis=0) > reach)
         if stale:
             g = self.grid
+            # the walls' layer; their ages are the planning layer's (a cell established in
+            # the walls' layer alone is young: person-sized pieces do not match it)
             walls = g.log_odds if g.wall_odds is None else g.wall_odds
             self._distance = distance_field(walls, g.origin, g.resolution, here,
                                             DISTANCE_FIELD_MARGIN, g.hit_offset,
