@@ -6,7 +6,6 @@ the ideal sensor with 1 cm noise; docs/alignment.md has the realistic sensor's
 figures."""
 
 import dataclasses
-import math
 from pathlib import Path
 
 import numpy as np
@@ -14,6 +13,7 @@ import pytest
 
 from subapf_planner.core.config import load_config
 from subapf_planner.core.memory import NavigationMemory
+from subapf_planner.core.robot import compose, invert
 from subapf_planner.core.scan import scan_to_points
 from subapf_planner.ros.paths import default_params_file
 from subapf_planner.sim.episode import run_episode
@@ -79,10 +79,8 @@ def test_walls_drawn_through_the_realistic_lidar_are_matched_where_they_stand(
             base = scan_to_points(scan, (0.0, 0.0, 0.0), CFG.laser_mount, CFG.obstacle_range)
             if len(base) and walls.grid.scans:
                 m = walls.align(base, truth)
-                if m.accepted:
-                    c, s = math.cos(truth[2]), math.sin(truth[2])
-                    e = m.pose - truth
-                    offsets.append((-s * e[0] + c * e[1], math.remainder(e[2], math.tau)))
+                if m.accepted:   # the match in the true pose's frame: across, heading
+                    offsets.append(compose(invert(truth), m.pose)[1:])
             walls.integrate(scan, scan_pose, *args, **kwargs)
         return integrate(self, scan, scan_pose, *args, **kwargs)
 
