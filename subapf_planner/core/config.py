@@ -126,6 +126,16 @@ class PlannerConfig:
                                     'to the centre '
                                     '(0.075 m ahead of the footprint; stopping from 0.22 m/s '
                                     'takes 0.024 m)', 'm', 0.0, 2.0)
+    contact_time: float = param(0.3, 'With the geodesic field: the last command is rolled '
+                                "out this long (a planning period, the scan's latency and "
+                                "braking) against the scan's returns, and its forward speed "
+                                'zeroed where the footprint would come within contact_margin '
+                                'of a return it closes on (core/contact_check.py); 0: off',
+                                's', 0.0, 5.0)
+    contact_margin: float = param(0.02, "Gap the command's rollout keeps from the returns it "
+                                  "closes on (less than the sampling's margin over the "
+                                  'footprint, so that a planned move is not refused)', 'm',
+                                  0.0, 0.5)
     # --- memory and navigation-function attraction (core/occupancy.py, navigation.py) --
     attraction_field: str = param('geodesic', 'Attraction: geodesic (distance to the goal '
                                   'through the occupancy memory, a navigation function with '

@@ -111,6 +111,15 @@ class Footprint:
             return np.zeros(p.shape[0], bool)
         return np.any(near & np.all(self._outside(fx, fy) <= margin, axis=-1), axis=1)
 
+    def gaps(self, poses: ArrayLike, points: ArrayLike) -> NDArray[np.float64]:
+        """How far each point (m, 2) lies outside the footprint placed at each pose (n, 3)
+        (n, m) [m]: the largest of its distances outside the edges' lines, which is the
+        distance where it faces an edge and less by a corner (on the safe side); <= 0
+        inside."""
+        p = np.atleast_2d(np.asarray(poses, float))
+        fx, fy = self._in_frames(p, np.asarray(points, float).reshape(-1, 2))
+        return np.max(self._outside(fx, fy), axis=-1)
+
     def covers(self, pose: ArrayLike, points: ArrayLike) -> NDArray[np.bool_]:
         """Per point (m, 2), whether it lies inside the footprint placed at ``pose``
         (x, y, yaw)."""

@@ -308,7 +308,8 @@ class NavigationMemory:
         if stale:
             g = self.grid
             # the walls' layer; their ages are the planning layer's (a cell established in
-            # the walls' layer alone is young: person-sized pieces do not match it)
+            # the walls' layer alone is young: person-sized pieces do not match it; ages
+            # of the walls' layer's own lost real-building tasks, docs/alignment.md)
             walls = g.log_odds if g.wall_odds is None else g.wall_odds
             self._distance = distance_field(walls, g.origin, g.resolution, here,
                                             DISTANCE_FIELD_MARGIN, g.hit_offset,

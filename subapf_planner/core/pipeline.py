@@ -2,9 +2,9 @@
 
 A stage is registered here by name, in one of three kinds (core/cycle.py): gates
 (core/gates.py), proposers (core/proposers.py), filters (core/approach.py,
-core/filters.py). The parameters choose them (:func:`stage_names`); the sampling's
-scoring terms are chosen by ``critics`` (core/critics/). A new stage is one module and
-a line here.
+core/filters.py, core/contact_check.py). The parameters choose them
+(:func:`stage_names`); the sampling's scoring terms are chosen by ``critics``
+(core/critics/). A new stage is one module and a line here.
 """
 
 from __future__ import annotations
@@ -14,6 +14,7 @@ from dataclasses import dataclass
 
 from .approach import FinalApproach
 from .config import PlannerConfig
+from .contact_check import ContactCheck
 from .cycle import Stage
 from .filters import Evasion
 from .gates import Goal, Mapping, Reachability
@@ -30,6 +31,7 @@ STAGES: dict[str, Callable[[NavigationMemory], Stage]] = {
     'dwa': lambda memory: Dwa(),
     'final_approach': lambda memory: FinalApproach(),
     'evasion': lambda memory: Evasion(),
+    'contact_check': lambda memory: ContactCheck(),
 }
 
 
@@ -51,7 +53,8 @@ def stage_names(cfg: PlannerConfig) -> StageNames:
     geodesic``) the mapping stand (with ``scan_alignment``) and the reachability gate;
     the proposer of ``method``; with the memory and ``final_approach`` the final
     approach filter (core/approach.py); the evasion filter with the tracker (not for
-    DWA, which does without)."""
+    DWA, which does without); last, with the memory and ``contact_time``, the contact
+    check (core/contact_check.py; not for DWA, whose arcs keep their own clearance)."""
     gates = ['goal']
     if cfg.geodesic and cfg.scan_alignment:
         gates.append('mapping')
@@ -61,6 +64,8 @@ def stage_names(cfg: PlannerConfig) -> StageNames:
     filters = ('final_approach',) if cfg.geodesic and cfg.final_approach else ()
     if cfg.tracks_moving and cfg.method != 'dwa':
         filters += ('evasion',)
+    if cfg.geodesic and cfg.contact_time > 0.0 and cfg.method != 'dwa':
+        filters += ('contact_check',)
     return StageNames(tuple(gates), proposer, filters)
 
 
