@@ -60,4 +60,3 @@ def test_a_polygon_is_checked_as_its_polygon():
     assert np.hypot(*side[0]) < cfg.robot_radius
     assert not closes_on((0.0, 0.0, 0.0), 0.2, 0.0, side, cfg)
     assert closes_on((0.0, 0.0, 0.0), 0.2, 1.0, side, cfg)
-

@@ -12,9 +12,8 @@ footprint would come within ``contact_margin`` of the returns, nearer than it is
 them now. Returns the robot keeps its distance from, or draws away from, do not stop
 it: a robot that stopped close to a wall may still drive off along it or away from
 it. A disc turns on the spot freely; a polygon keeps the turn only where turning on
-the spot for
-``contact_time`` brings no corner within TURN_MARGIN of a return (core/footprint.py),
-else it stands (``no_safe_move``).
+the spot for ``contact_time`` brings no corner within TURN_MARGIN of a return
+(core/footprint.py), else it stands (``no_safe_move``).
 """
 
 from __future__ import annotations
