@@ -12,8 +12,8 @@ footprint would come within ``contact_margin`` of the returns, nearer than it is
 them now. Returns the robot keeps its distance from, or draws away from, do not stop
 it: a robot that stopped close to a wall may still drive off along it or away from
 it. A disc turns on the spot freely; a polygon keeps the turn only where turning on
-the spot for ``contact_time`` brings no corner within TURN_MARGIN of a return
-(core/footprint.py), else it stands (``no_safe_move``).
+the spot for ``contact_time`` brings no corner near a return (core/command.py
+``turn_blocked``), else it stands (``no_safe_move``).
 """
 
 from __future__ import annotations
@@ -23,10 +23,9 @@ import dataclasses
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from .command import Command
+from .command import Command, turn_blocked
 from .config import PlannerConfig
 from .cycle import Cycle, Stage
-from .footprint import TURN_MARGIN
 from .rollout import arcs
 from .status import Status
 
@@ -80,9 +79,7 @@ class ContactCheck(Stage):
         cfg, pose, points = cycle.cfg, cycle.pose, cycle.obstacles
         if not closes_on(pose, cmd.v, cmd.w, points, cfg):
             return cycle
-        shape = cfg.polygon
-        if shape is not None and shape.turn_contact(pose, cmd.w * cfg.contact_time, points,
-                                                    TURN_MARGIN):
+        if turn_blocked(pose, cmd.w * cfg.contact_time, points, cfg):
             command = Command(0.0, 0.0, Status.NO_SAFE_MOVE)
         else:
             command = Command(0.0, cmd.w, Status.BLOCKED_AHEAD)
