@@ -3,7 +3,7 @@
 import math
 import threading
 
-from hypothesis import given, settings
+from hypothesis import example, given, settings
 from hypothesis import strategies as st
 import numpy as np
 import pytest
@@ -155,6 +155,8 @@ def field_on(occ, goal, robot=(0.1, 0.1), inflation=0.0, soft=0.0, coarsening=1,
 @given(seed=st.integers(0, 2**31 - 1), fill=st.floats(0.0, 0.35),
        inflation=st.sampled_from([0.0, 0.06, 0.125]), soft=st.sampled_from([0.0, 0.2]),
        coarsening=st.sampled_from([1, 2, 3]), discount=st.sampled_from([0.0, 0.2, 0.6]))
+# second-order fast marching left a pit at the patch's border here (navigation._fill_pits)
+@example(seed=2663, fill=0.109375, inflation=0.06, soft=0.0, coarsening=1, discount=0.0)
 def test_no_local_minimum_but_the_goal(seed, fill, inflation, soft, coarsening, discount):
     """Every reachable cell but the goal's has an 8-neighbour with a strictly lower value
     (on the cells the field is marched on: map cells, or blocks of them), also with a

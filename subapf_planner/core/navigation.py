@@ -10,7 +10,11 @@ sampling stay as the local layer that keeps the path smooth and clear.
 
 Computed by fast marching (scikit-fmm, Sethian 1996), which solves the eikonal
 equation |grad T| = 1 / speed and is close to Euclidean (8-connected Dijkstra
-overestimates by up to 8 %). Only occupied cells are walls of the field; the
+overestimates by up to 8 %). Its second-order stencil reaches two cells upwind and
+can leave a cell beside a wall or the patch's border lower than all its neighbours
+(a pit, found by test_memory.py's property test); each such cell is raised just
+above its lowest neighbour (``_fill_pits``), which keeps the one minimum. Only
+occupied cells are walls of the field; the
 speed is ``MIN_SPEED`` within ``inflation_radius`` of them (a robot found there is
 led out, not stranded; and, when asked, within ``gap_clearance``: the sampling's
 clearance, so that a gap the local layer will not enter costs as much as contact),
@@ -407,4 +411,25 @@ def _travel_distance(walls: NDArray[np.bool_], speed: NDArray[np.float64],
         return None
     values = np.ma.filled(np.ma.masked_invalid(t).astype(float), np.inf)
     values[goal] = 0.0
-    return np.maximum(values, 0.0)
+    return _fill_pits(np.maximum(values, 0.0), speed, goal, cell)
+
+
+def _fill_pits(values: NDArray[np.float64], speed: NDArray[np.float64],
+               goal: tuple[int, int], cell: float) -> NDArray[np.float64]:
+    """``values`` (changed in place) with every finite cell but the ``goal`` that has no
+    strictly lower 8-neighbour raised to its lowest neighbour's value plus its own step
+    (``cell`` over its ``speed``), until no such cell is left: what second-order fast
+    marching leaves beside a wall or the border, a few cells in a field, mostly none.
+    Values only rise and each raise is above a neighbour's value, so it ends; bounded by
+    the number of cells in any case."""
+    h, w = values.shape
+    for _ in range(values.size):
+        padded = np.pad(values, 1, constant_values=np.inf)
+        lowest = np.min([padded[1 + dr:1 + dr + h, 1 + dc:1 + dc + w] for dr, dc in NEIGHBOURS],
+                        axis=0)
+        pit = np.isfinite(values) & np.isfinite(lowest) & ~(lowest < values)
+        pit[goal] = False
+        if not pit.any():
+            break
+        values[pit] = lowest[pit] + cell / speed[pit]
+    return values
