@@ -70,6 +70,11 @@ def cell_index(points: ArrayLike, origin: ArrayLike, resolution: float) -> NDArr
                     / resolution).astype(np.int64)
 
 
+#: The window's per-cell arrays (OccupancyGrid attributes), which shift with it and
+#: make up its memory.
+LAYERS = ('log_odds', 'hit_offset', 'hit_count', 'established_at', 'wall_odds')
+
+
 class OccupancyGrid:
     """A ``size`` x ``size`` m log-odds window at ``resolution`` m, in odom.
 
@@ -120,8 +125,7 @@ class OccupancyGrid:
     @property
     def nbytes(self) -> int:
         """Memory held by the grid [bytes]."""
-        layers = (self.log_odds, self.hit_offset, self.hit_count, self.established_at,
-                  self.wall_odds)
+        layers = (getattr(self, name) for name in LAYERS)
         return int(sum(a.nbytes for a in layers if a is not None))
 
     def cell_of(self, points: ArrayLike) -> NDArray[np.int64]:
@@ -199,11 +203,9 @@ class OccupancyGrid:
         d = np.round((new_origin - self.origin) / self.resolution).astype(int)  # (dx, dy)
         n = self.cells
         dx, dy = int(d[0]), int(d[1])
-        layers = []
-        for a in (self.log_odds, self.hit_offset, self.hit_count, self.established_at,
-                  self.wall_odds):
+        for name in LAYERS:
+            a = getattr(self, name)
             if a is None:   # no hit places kept
-                layers.append(a)
                 continue
             shifted = np.full_like(a, NOT_ESTABLISHED) if a is self.established_at \
                 else np.zeros_like(a)
@@ -213,9 +215,7 @@ class OccupancyGrid:
                 src_c = slice(max(dx, 0), n + min(dx, 0))
                 dst_c = slice(max(-dx, 0), n + min(-dx, 0))
                 shifted[dst_r, dst_c] = a[src_r, src_c]
-            layers.append(shifted)
-        (self.log_odds, self.hit_offset, self.hit_count, self.established_at,
-         self.wall_odds) = layers
+            setattr(self, name, shifted)
         self.origin = new_origin
         self.version += 1
         if self.known is not None:   # the cells that came in start from the known map
