@@ -344,11 +344,12 @@ def robot_fields(robot: RobotDescription) -> dict[str, float]:
     """The PlannerConfig fields that come from ``robot``: its footprint and the clearances
     derived from it (inflation, samples, DWA, the safety corridor), its laser's mounting
     and range (at most half the default occupancy window: a return beyond it has no
-    cell), its limits and planning rate, and the lengths the planner steps by, scaled by
-    how far the robot goes in one period (RobotDescription.pace: the sampling circle,
-    the longest raw step, the slow-down before the goal; 1 for the burger, whose
-    figures they are), and its acceleration limits where the robot states them; a robot
-    whose laser does not see behind it never reverses (reverse_speed 0)."""
+    cell) and range noise, its limits and planning rate, and the lengths the planner
+    steps by, scaled by how far the robot goes in one period (RobotDescription.pace:
+    the sampling circle, the longest raw step, the slow-down before the goal; 1 for
+    the burger, whose figures they are), and its acceleration limits where the robot
+    states them; a robot whose laser does not see behind it never reverses
+    (reverse_speed 0)."""
     mount = robot.laser
     pace = robot.pace
     # a polygon: the field keeps the half-width from walls (a gap the robot drives
@@ -370,6 +371,7 @@ def robot_fields(robot: RobotDescription) -> dict[str, float]:
         'reverse_speed': robot.max_linear_velocity if robot.sees_all_round else 0.0,
         'max_angular_velocity': robot.max_angular_velocity,
         'planning_frequency': robot.planning_frequency,
+        'range_noise_floor': robot.range_noise[0], 'range_noise_fraction': robot.range_noise[1],
         'sample_radius': round(PlannerConfig.sample_radius * pace, 4),
         'max_step': round(PlannerConfig.max_step * pace, 4),
         'slowdown_distance': round(PlannerConfig.slowdown_distance * pace, 4),

@@ -99,6 +99,11 @@ class RobotDescription:
     #: does not see behind it, and never reverses).
     lidar: str = 'lds01'
     laser_fov: float = 2.0 * math.pi
+    #: The lidar's range noise as the planner models it (PlannerConfig.range_noise_floor
+    #: and range_noise_fraction): a standard deviation [m] near it, and a fraction of
+    #: the range farther out, the datasheet's accuracy taken as two standard deviations
+    #: (the LDS-01's: +/-15 mm below 0.5 m, +/-5 % to 3.5 m).
+    range_noise: tuple[float, float] = (0.0075, 0.025)
     #: How often the planner plans [Hz].
     planning_frequency: float = 5.0
     #: The simulator's body beyond footprint and wheels.
@@ -216,13 +221,16 @@ TURTLEBOT4 = RobotDescription(
     wheel_radius=0.03575, wheel_separation=0.233, max_linear_velocity=0.26,
     max_angular_velocity=1.0, base_link_height=0.0, base_frame='base_link',
     laser_frame='rplidar_link', laser_range=12.0, stamped_cmd_vel=True, lidar='rplidar_a1',
+    range_noise=(0.0025, 0.005),
     body=Body(mass=3.3, height=0.1, bottom=0.02, wheel_width=0.02, wheel_torque=1.5),
     source='turtlebot4_navigation/config/nav2.yaml for Jazzy (robot_radius 0.175 m; '
     'velocity_smoother max_velocity 0.26 m/s, 1.0 rad/s; enable_stamped_cmd_vel true); '
     'turtlebot4_description/urdf/standard/turtlebot4.urdf.xacro (rplidar_link 0.04 m '
     'behind base_link, turned by +pi/2, about 0.193 m up); irobot_create_description '
     '(body radius 0.164 m, wheels 0.03575 m, 0.233 m apart; base_link on the ground: '
-    'it is the base frame; 3.3 kg); RPLIDAR A1M8 0.15-12 m; the motor torque estimated')
+    'it is the base frame; 3.3 kg); RPLIDAR A1M8 0.15-12 m, accuracy 1 % of the range up '
+    'to 3 m (Slamtec datasheet; the range noise: half of it, and at 0.5 m near the '
+    'laser); the motor torque estimated')
 #: Clearpath Jackal as the BARN Challenge runs it: a SICK LMS111 on its front mount,
 #: planning at 20 Hz. Its four wheels (skid steering) are two in the simulator, at the
 #: track, with casters: the same kinematics as its diff-drive controller's.
@@ -234,6 +242,7 @@ JACKAL = RobotDescription(
     max_linear_acceleration=3.4, max_angular_acceleration=13.0,
     footprint=((0.254, -0.215), (0.254, 0.215), (-0.254, 0.215), (-0.254, -0.215)),
     lidar='lms111', laser_fov=math.radians(270.0), planning_frequency=20.0,
+    range_noise=(0.012, 0.0),
     body=Body(mass=17.0, height=0.185, bottom=0.065, wheel_width=0.04, wheel_torque=17.0),
     source='Clearpath Jackal specifications (outer dimensions 508 x 430 x 250 mm, the '
     'footprint here, bumpers and wheels included: its farthest corner 0.333 m out; 17 kg; '
@@ -241,8 +250,10 @@ JACKAL = RobotDescription(
     '25 rad/s^2); jackal_description jackal.urdf.xacro (wheel radius 0.098 m, track '
     '0.376 m, wheel width 0.040 m; the front mount 0.12 m ahead of base_link) and '
     'sick_lms1xx_mount.urdf.xacro (the focal point 0.149 m above the bracket: about '
-    '0.40 m up); the BARN Challenge (a SICK LMS1xx, 270 degrees; ROS Noetic: Twist on '
-    'cmd_vel; the challenge costmap footprint 0.42 x 0.33 m is narrower than the wheels); '
+    '0.40 m up); SICK LMS111-10100 datasheet (statistical error 12 mm, the range '
+    'noise; its systematic +/-30 mm a fixed offset per unit); the BARN Challenge (a SICK '
+    'LMS1xx, 270 degrees; ROS Noetic: Twist on cmd_vel; the challenge costmap footprint '
+    '0.42 x 0.33 m is narrower than the wheels); '
     "the 20 Hz planning rate is this package's choice for a 2 m/s robot; the body's "
     'bottom (0.065 m) and motor torque (17 N m: 20 m/s^2 for 17 kg on 0.098 m wheels) '
     "are estimates; the accelerations are what the wheels' grip gives, not the "
