@@ -195,8 +195,7 @@ class NavigationField:
         """Per cell (flat index), the flat index of its lowest 8-neighbour when that is
         strictly lower, else -1 (the goal, cut-off cells). Computed once per field."""
         h, w = self.values.shape
-        p = self.padded
-        nb = np.stack([p[PAD + dr:PAD + dr + h, PAD + dc:PAD + dc + w] for dr, dc in NEIGHBOURS])
+        nb = _neighbours(self.padded, PAD, (h, w))
         k = np.argmin(nb, axis=0)
         lower = np.take_along_axis(nb, k[None], axis=0)[0] < self.values
         rows, cols = np.indices((h, w))
@@ -414,6 +413,15 @@ def _travel_distance(walls: NDArray[np.bool_], speed: NDArray[np.float64],
     return _fill_pits(np.maximum(values, 0.0), speed, goal, cell)
 
 
+def _neighbours(padded: NDArray[np.float64], pad: int,
+                shape: tuple[int, int]) -> NDArray[np.float64]:
+    """The 8 neighbours' values (8, h, w) of each cell of a field of ``shape`` (h, w),
+    from the field ``padded`` with ``pad`` cells of inf (in NEIGHBOURS' order)."""
+    h, w = shape
+    return np.stack([padded[pad + dr:pad + dr + h, pad + dc:pad + dc + w]
+                     for dr, dc in NEIGHBOURS])
+
+
 def _fill_pits(values: NDArray[np.float64], speed: NDArray[np.float64],
                goal: tuple[int, int], cell: float) -> NDArray[np.float64]:
     """``values`` (changed in place) with every finite cell but the ``goal`` that has no
@@ -422,11 +430,9 @@ def _fill_pits(values: NDArray[np.float64], speed: NDArray[np.float64],
     marching leaves beside a wall or the border, a few cells in a field, mostly none.
     Values only rise and each raise is above a neighbour's value, so it ends; bounded by
     the number of cells in any case."""
-    h, w = values.shape
     for _ in range(values.size):
-        padded = np.pad(values, 1, constant_values=np.inf)
-        lowest = np.min([padded[1 + dr:1 + dr + h, 1 + dc:1 + dc + w] for dr, dc in NEIGHBOURS],
-                        axis=0)
+        lowest = _neighbours(np.pad(values, 1, constant_values=np.inf), 1,
+                             values.shape).min(axis=0)
         pit = np.isfinite(values) & np.isfinite(lowest) & ~(lowest < values)
         pit[goal] = False
         if not pit.any():
