@@ -148,6 +148,9 @@ def test_a_polygon_footprint_is_checked():
         replace(robot, footprint=((0.1, 0.1), (0.3, 0.1), (0.3, 0.3), (0.1, 0.3)), radius=0.5)
     with pytest.raises(ValueError, match='planning_frequency must be positive'):
         replace(BURGER, planning_frequency=0.0)
+    for bad in ((0.01, math.nan), (-0.01, 0.02), (0.01,)):
+        with pytest.raises(ValueError, match='range_noise must be'):
+            replace(BURGER, range_noise=bad)
 
 
 def test_simulated_wall_lands_where_the_planners_mounting_puts_it():

@@ -117,6 +117,10 @@ class RobotDescription:
                            ('planning_frequency', self.planning_frequency)):
             if not (math.isfinite(value) and value > 0.0):
                 raise ValueError(f'{self.name}: {key} must be positive, got {value}')
+        if len(self.range_noise) != 2 or not all(
+                math.isfinite(v) and v >= 0.0 for v in self.range_noise):
+            raise ValueError(f'{self.name}: range_noise must be (floor [m], fraction), both '
+                             f'finite and not negative, got {self.range_noise}')
         if self.footprint:
             shape = Footprint(np.asarray(self.footprint, float))   # ValueError if no polygon
             if self.radius < shape.circumscribed - 1e-9:
