@@ -86,6 +86,22 @@ def test_a_standing_object_and_a_wall_do_not_move():
     assert np.hypot(*tracks.velocity[0]) < 0.04
 
 
+def test_one_walking_behind_another_does_not_stop_the_first():
+    """Two people walking in file at 0.2 m/s, 0.8 m apart, past a robot 2 m away: both
+    move from their first seconds, and the first still moves once the second walks
+    where the first was first seen (its returns there are a mover's, not the place
+    still taken)."""
+    tr = Tracker(0.15, 1.2, 0.6, 0.04)
+    robot = (0.0, -2.0)
+    for k in range(31):
+        t = 0.2 * k
+        ahead, behind = np.array([0.2 * t, 0.0]), np.array([0.2 * t - 0.8, 0.0])
+        pts = np.vstack((disc_points(ahead, 0.2, robot), disc_points(behind, 0.2, robot)))
+        tracks = tr.update(pts, t, np.zeros(len(pts)))
+        if t >= 3.0:
+            assert len(tracks.position) == 2 and tracks.moving.all(), t
+
+
 def first_moving_time(log_odds: float, speed: float = 0.22) -> float:
     """When a disc of radius 0.25 m walking at ``speed`` [m/s] across cells of the
     memory's ``log_odds`` is first known to move [s after it was first seen]."""

@@ -26,7 +26,9 @@ had seen free; someone walking to and fro stays a mover), and it has left that
 place. How far it went is measured at the scans it is seen (not from predictions);
 it has left the place when fewer than STILL_FRACTION of the points it was first seen
 at have a return of another cluster within VACATED_RADIUS (or two standard
-deviations of the return's range noise): a piece of a long wall that noise and
+deviations of the return's range noise), not counting the returns of tracks that
+moved at the last scan and have gone twice MOVE_DISTANCE (someone walking behind
+another steps where the first was first seen): a piece of a long wall that noise and
 dropped beams cut out of it, sliding along it as the robot drives, is still where it
 began, the rest of the wall returning there. It is
 **held** out of the occupancy memory while it moves, and while its cluster is new
@@ -387,9 +389,17 @@ class Tracker:
         moving = (self.hits >= MIN_HITS) & (speed >= self.moving_speed) \
             & (self.went >= went) & free
         point_track = track_of[labels] if count else np.zeros(0, np.int64)
-        for k in np.flatnonzero(moving):   # and it has left where it was first seen
-            moving[k] = not _still_there(self.first_points[k], points[point_track != k],
-                                         None if sigma is None else sigma[point_track != k])
+        # and it has left where it was first seen: returns there of its own or of another
+        # that moved at the last scan, twice MOVE_DISTANCE from where it was first seen,
+        # do not hold it (one walking behind another steps where the first was first
+        # seen; two pieces of clutter that seem to move have not gone that far)
+        walked = self.moved & (self.went >= 2.0 * MOVE_DISTANCE)
+        mover_point = (point_track >= 0) & walked[np.maximum(point_track, 0)] \
+            if len(walked) else np.zeros(len(points), bool)
+        for k in np.flatnonzero(moving):
+            other = (point_track != k) & ~mover_point
+            moving[k] = not _still_there(self.first_points[k], points[other],
+                                         None if sigma is None else sigma[other])
         self.moved = moving.copy()
         held = moving | ((self.new_age >= 0) & (self.new_age < NEW_OBJECT_SCANS))
         # held[id] by track id; the last slot (id -1: a point of no track) stays False
