@@ -148,10 +148,7 @@ class Tracks:
     trail: NDArray[np.float64] = field(default_factory=lambda: np.zeros((0, 2)))
 
     def _of_points(self, flags: NDArray[np.bool_]) -> NDArray[np.bool_]:
-        idx = self.point_track
-        if not flags.size:
-            return np.zeros(idx.shape, bool)
-        return (idx >= 0) & flags[np.maximum(idx, 0)]
+        return _of_points(self.point_track, flags)
 
     @property
     def held_points(self) -> NDArray[np.bool_]:
@@ -393,9 +390,7 @@ class Tracker:
         # that moved at the last scan, twice MOVE_DISTANCE from where it was first seen,
         # do not hold it (one walking behind another steps where the first was first
         # seen; two pieces of clutter that seem to move have not gone that far)
-        walked = self.moved & (self.went >= 2.0 * MOVE_DISTANCE)
-        mover_point = (point_track >= 0) & walked[np.maximum(point_track, 0)] \
-            if len(walked) else np.zeros(len(points), bool)
+        mover_point = _of_points(point_track, self.moved & (self.went >= 2.0 * MOVE_DISTANCE))
         for k in np.flatnonzero(moving):
             other = (point_track != k) & ~mover_point
             moving[k] = not _still_there(self.first_points[k], points[other],
@@ -412,6 +407,14 @@ class Tracker:
                             moving, held, point_track,
                             np.vstack(trail) if trail else np.zeros((0, 2)))
         return self._last
+
+
+def _of_points(point_track: NDArray[np.int64], flags: NDArray[np.bool_]) -> NDArray[np.bool_]:
+    """Per point: whether the track it belongs to (``point_track``, -1: none) is flagged
+    in ``flags`` (one per track)."""
+    if not flags.size:
+        return np.zeros(point_track.shape, bool)
+    return (point_track >= 0) & flags[np.maximum(point_track, 0)]
 
 
 def _some_points(points: NDArray[np.float64], labels: NDArray[np.int64],
