@@ -10,10 +10,12 @@ import pytest
 from subapf_planner.core.config import PlannerConfig
 from subapf_planner.core.evasion import (
     STATIC_MARGIN,
+    TOUCH_HYSTERESIS,
     Escape,
     candidates,
     evade,
     halted,
+    least_bad,
     moving_gap,
     rollout,
     rollout_step,
@@ -100,6 +102,32 @@ def test_one_walking_behind_another_does_not_stop_the_first():
         tracks = tr.update(pts, t, np.zeros(len(pts)))
         if t >= 3.0:
             assert len(tracks.position) == 2 and tracks.moving.all(), t
+
+
+def seen_disc(center, radius, beams=360):
+    """Where a lidar at the origin with ``beams`` beams over the turn meets a disc (k, 2)."""
+    c = np.asarray(center, float)
+    a = 2 * math.pi * np.arange(beams) / beams
+    ray = np.column_stack((np.cos(a), np.sin(a)))
+    along = ray @ c
+    off = along ** 2 - (c @ c - radius ** 2)
+    hit = (off >= 0) & (along > 0)
+    return ray[hit] * (along[hit] - np.sqrt(off[hit]))[:, None]
+
+
+def test_a_person_close_to_the_lidar_is_not_a_piece_of_wall():
+    """A person (disc of radius 0.25 m) 0.2 m from the lidar shows a wide, shallow arc,
+    most beams on its middle (within 0.02 m of a line over 0.3 m): it bends like a
+    disc, so it is tracked; a straight piece as long, 1 cm noise, is not."""
+    rng = np.random.default_rng(3)
+    person = seen_disc((0.0, 0.45), 0.25)
+    u = np.linspace(-0.15, 0.15, len(person))
+    piece = np.column_stack((u, np.full(len(u), 0.45) + rng.normal(0, 0.01, len(u))))
+    for pts, tracked in ((person, 1), (piece, 0)):
+        dev = np.linalg.eigvalsh(np.cov(pts.T, bias=True))
+        assert math.sqrt(dev[0]) < 0.02 and np.ptp(pts[:, 0]) > 0.25
+        tracks = Tracker(0.15, 1.2, 0.6, 0.04).update(pts, 0.0, np.zeros(len(pts)))
+        assert len(tracks.position) == tracked
 
 
 def first_moving_time(log_odds: float, speed: float = 0.22) -> float:
@@ -298,6 +326,19 @@ def test_something_coming_at_a_standing_robot_makes_it_back_off():
     v, w = evade(pose, (0.0, 0.0), head_on(), np.zeros((0, 2)),
                  CFG.replace(reverse_speed=0.0), blocked_ahead=False).command
     assert v >= 0.0
+
+
+def test_with_no_escape_clear_the_committed_one_stays_unless_clearly_worse():
+    """No escape keeps the clearance: the latest touch wins, and the committed escape
+    (the last) stays while it touches no more than TOUCH_HYSTERESIS sooner and its gap
+    is within HYSTERESIS; one that never touches replaces it."""
+    gap = np.array([0.05, 0.04, 0.05])
+    assert least_bad(np.array([1.0, 1.4, 1.2]), gap, committed=False) == 1
+    assert least_bad(np.array([1.0, 1.4, 1.4 - TOUCH_HYSTERESIS]), gap, committed=True) == 2
+    assert least_bad(np.array([1.0, 1.4, 1.3 - TOUCH_HYSTERESIS]), gap, committed=True) == 1
+    assert least_bad(np.array([1.0, 1.4, 1.4]), np.array([0.05, 0.09, 0.05]),
+                     committed=True) == 1
+    assert least_bad(np.array([1.0, math.inf, 2.8]), gap, committed=True) == 1
 
 
 def test_a_plan_that_keeps_clear_is_kept():

@@ -21,7 +21,9 @@ keeps it, one that never touches a predicted disc within the horizon, else the o
 that touches latest, and among those the largest gap (it never stands still in an
 obstacle's way while a way out exists). Gaps are time-weighted so that a meeting
 soon counts more than one later. The chosen manoeuvre is committed: the next cycle
-considers it again, one period on.
+considers it again, one period on, and keeps it while it keeps the clearance (when
+none does, while it touches no more than TOUCH_HYSTERESIS sooner than the best and its
+gap is within HYSTERESIS: least_bad).
 """
 
 from __future__ import annotations
@@ -57,6 +59,11 @@ TURN_TIMES = (None, 0.6, 1.2)
 #: When no escape keeps the clearance, the committed one stays while its gap is within
 #: this of the largest [m] (no flipping between escapes of nearly the same gap).
 HYSTERESIS = 0.02
+#: ... and while it touches a predicted disc no more than this sooner than the latest [s]
+#: (touch times come in rollout steps, and a walker's predicted path wavers with its
+#: velocity estimate: beside slow walkers the choice flipped between driving on and
+#: backing up, cycle after cycle).
+TOUCH_HYSTERESIS = 0.4
 
 
 def rollout_step(period: float) -> tuple[float, int]:
@@ -214,9 +221,17 @@ def evade(pose: NDArray[np.float64], planned: tuple[float, float], tracks: Track
         near = np.abs(v - v0) + cfg.escape_turn_weight * np.abs(turn[:, 0] - w0)
         score = np.where(kept, -1.0, near)
         return options[int(np.lexsort((-gap, np.where(safe, score, math.inf)))[0])]
-    # none keeps the clearance: one that never touches, else the latest touch; then the
-    # largest gap (the committed one while within HYSTERESIS of it)
+    return options[least_bad(touch, gap, bool(kept[-1]))]
+
+
+def least_bad(touch: NDArray[np.float64], gap: NDArray[np.float64], committed: bool) -> int:
+    """Among escapes none of which keeps the clearance, with their contact times (c,)
+    [s] (inf: never) and gaps (c,) [m] (-inf: inadmissible): the index of one that never
+    touches, else of the latest touch, then of the largest gap; the last one instead
+    if it is the ``committed`` escape and within TOUCH_HYSTERESIS and HYSTERESIS of
+    that."""
     best = int(np.lexsort((-gap, -touch))[0])
-    if kept[-1] and touch[-1] >= touch[best] and gap[-1] >= gap[best] - HYSTERESIS:
-        best = len(options) - 1
-    return options[best]
+    if committed and touch[-1] >= touch[best] - TOUCH_HYSTERESIS \
+            and gap[-1] >= gap[best] - HYSTERESIS:
+        return len(touch) - 1
+    return best
