@@ -104,23 +104,14 @@ def test_one_walking_behind_another_does_not_stop_the_first():
             assert len(tracks.position) == 2 and tracks.moving.all(), t
 
 
-def seen_disc(center, radius, beams=360):
-    """Where a lidar at the origin with ``beams`` beams over the turn meets a disc (k, 2)."""
-    c = np.asarray(center, float)
-    a = 2 * math.pi * np.arange(beams) / beams
-    ray = np.column_stack((np.cos(a), np.sin(a)))
-    along = ray @ c
-    off = along ** 2 - (c @ c - radius ** 2)
-    hit = (off >= 0) & (along > 0)
-    return ray[hit] * (along[hit] - np.sqrt(off[hit]))[:, None]
-
-
 def test_a_person_close_to_the_lidar_is_not_a_piece_of_wall():
     """A person (disc of radius 0.25 m) 0.2 m from the lidar shows a wide, shallow arc,
     most beams on its middle (within 0.02 m of a line over 0.3 m): it bends like a
     disc, so it is tracked; a straight piece as long, 1 cm noise, is not."""
     rng = np.random.default_rng(3)
-    person = seen_disc((0.0, 0.45), 0.25)
+    r = scan_of((0.0, 0.0), discs=[((0.0, 0.45), 0.25)])
+    seen = np.isfinite(r)
+    person = r[seen, None] * np.column_stack((np.cos(ANGLES[seen]), np.sin(ANGLES[seen])))
     u = np.linspace(-0.15, 0.15, len(person))
     piece = np.column_stack((u, np.full(len(u), 0.45) + rng.normal(0, 0.01, len(u))))
     for pts, tracked in ((person, 1), (piece, 0)):
