@@ -57,22 +57,6 @@ def test_open_beam_clears_up_to_its_range():
     assert grid.log_odds[tuple(grid.cell_of([0.05, 0.0])[0])] == 0.5   # within range_min
 
 
-def test_a_return_beyond_the_range_it_clears_is_no_wall():
-    """A return beyond ``clear_range`` (the planner's obstacle_range, which a 12 m
-    RPLIDAR or a 20 m LMS111 can exceed) marks nothing and clears up to that range, as a
-    beam with no echo does. Marked, a walker seen 11 m away beside the goal stayed a
-    wall there: no echo within 10 m clears it, and the TurtleBot 4 gave up its goal as
-    unreachable before it drove that near (`head_on_001` of its moving suite)."""
-    grid = OccupancyGrid(RES, 30.0)
-    grid.log_odds[:] = 0.5
-    grid.update(Scan([11.0], 0.0, 0.01, 0.15, 12.0), (0.0, 0.0, 0.0), clear_range=10.0)
-    assert grid.log_odds[tuple(grid.cell_of([9.9, 0.0])[0])] < 0.5     # cleared to 10 m
-    assert grid.log_odds[tuple(grid.cell_of([10.5, 0.0])[0])] == 0.5   # beyond: untouched
-    assert grid.log_odds[tuple(grid.cell_of([11.0, 0.0])[0])] == 0.5   # no wall marked
-    grid.update(Scan([9.0], 0.0, 0.01, 0.15, 12.0), (0.0, 0.0, 0.0), clear_range=10.0)
-    assert grid.log_odds[tuple(grid.cell_of([9.0, 0.0])[0])] > 0.5     # within: a wall
-
-
 def test_a_held_new_object_is_not_cleared_by_its_own_returns_that_fell_long():
     """Returns held out of the memory mark nothing. Those of something held because it
     is new (NavigationMemory.integrate's ``unmoved``) clear their rays only up to two

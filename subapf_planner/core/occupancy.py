@@ -7,15 +7,12 @@ This grid is what the navigation field (core/navigation.py) is computed on.
 
 Update rule, per beam of a scan taken at the laser's odom pose:
 
-* a valid return (finite, in [range_min, range_max)) within ``clear_range``
-  adds ``hit`` to the log odds of its end cell and ``miss`` to every cell the
-  beam crossed before it, from range_min on (a lidar says nothing about what is
-  closer to it);
-* a ``+inf`` return (no echo within range), and a valid one beyond
-  ``clear_range``, adds ``miss`` along the whole beam from range_min up to
-  ``clear_range`` (at most range_max): open space is forgotten obstacles. What
-  the memory could not clear it does not mark (a return beyond the range it
-  clears, written as a wall, would stay there until the robot came that near);
+* a valid return (finite, in [range_min, range_max)) adds ``hit`` to the log
+  odds of its end cell and ``miss`` to every cell the beam crossed before it,
+  from range_min on (a lidar says nothing about what is closer to it);
+* a ``+inf`` return (no echo within range) adds ``miss`` along the whole beam
+  from range_min up to ``clear_range`` (at most range_max): open space is
+  forgotten obstacles;
 * NaN, 0.0, negative and below-range_min returns are not evidence of anything
   (LDS-01 and LDS-02 invalid beams) and change nothing.
 
@@ -244,10 +241,10 @@ class OccupancyGrid:
         r = np.asarray(scan.ranges, float).ravel()
         lx, ly, lyaw = (float(v) for v in laser_pose)
         angles = scan.angles + lyaw
+        hit = scan.valid()
         reach = min(scan.range_max, clear_range)
-        hit = scan.valid(reach)
-        with np.errstate(invalid='ignore'):   # no echo, or one beyond what is cleared
-            open_beam = (np.isposinf(r) | (scan.valid() & ~hit)) & (reach > scan.range_min)
+        with np.errstate(invalid='ignore'):
+            open_beam = np.isposinf(r) & (reach > scan.range_min)
         lengths = np.where(hit, r, np.where(open_beam, reach, 0.0))
         use = hit | open_beam
         if not np.any(use):
