@@ -13,6 +13,7 @@ from subapf_planner.core.evasion import (
     TOUCH_HYSTERESIS,
     Escape,
     candidates,
+    driven,
     evade,
     halted,
     least_bad,
@@ -21,9 +22,9 @@ from subapf_planner.core.evasion import (
     rollout_step,
 )
 from subapf_planner.core.planner import Planner
-from subapf_planner.core.rollout import rollouts
+from subapf_planner.core.rollout import ramped, rollouts, steps
 from subapf_planner.core.scan import Scan
-from subapf_planner.core.tracking import Tracker, Tracks
+from subapf_planner.core.tracking import COAST_TIME, MAX_MISSES, Tracker, Tracks
 
 pytestmark = pytest.mark.core
 
@@ -74,6 +75,65 @@ def test_a_cluster_seen_late_in_the_sweep_is_placed_at_the_scan_s_time(late):
     assert np.hypot(*(a.position[0] - truth)) < 0.03
     assert np.hypot(*(a.velocity[0] - v)) < 0.1
     assert np.hypot(*(b.position[0] - truth)) == pytest.approx(late, abs=0.03)
+
+
+def crossing_out_of_view(hidden, speed=1.0, period=0.05, until=4.5):
+    """A walker at ``speed`` [m/s] walking out of the laser's view into x < 0, where
+    ``hidden`` says the laser sees nothing (seen while its centre is at x > 0),
+    scanned every ``period`` [s]: {time: tracks} and the walker's centre at each time."""
+    tr = Tracker(0.15, 1.2, 0.6, 0.04)
+    v, start = np.array([-speed, 0.0]), np.array([2.0, 1.5])
+    out, where = {}, {}
+    for k in range(int(round(until / period)) + 1):
+        t = round(k * period, 9)
+        c = start + v * t
+        pts = disc_points(c, 0.2) if c[0] > 1e-9 else np.zeros((0, 2))
+        out[t] = tr.update(pts, t, np.zeros(len(pts)), hidden=hidden)
+        where[t] = c
+    return out, where
+
+
+def test_a_walker_behind_the_laser_is_carried_on_one_gone_in_view_is_dropped():
+    """A walker at 1 m/s leaving a 270-degree laser's view (gone at t = 2 s) stays a
+    moving track, where it walks, for COAST_TIME, then is dropped; the same walker
+    vanishing where the laser sees (a lidar that sees all round) is dropped after
+    MAX_MISSES scans."""
+    gone = 2.0
+    blind, where = crossing_out_of_view(lambda p: p[:, 0] < 0.0)
+    later = round(gone + 0.5 * COAST_TIME, 2)
+    tracks = blind[later]
+    assert len(tracks.position) == 1 and tracks.moving[0]
+    assert np.hypot(*(tracks.position[0] - where[later])) < 0.2   # within its radius
+    assert len(blind[round(gone + COAST_TIME + 0.2, 2)].position) == 0
+    seen, _ = crossing_out_of_view(lambda p: np.zeros(len(p), bool))
+    assert len(seen[round(gone + (MAX_MISSES + 1) * 0.05, 2)].position) == 0
+
+
+def test_escapes_change_speed_as_the_base_can():
+    """With escape_ramps (limits that are the base's own), a 2 m/s robot told to stand
+    runs its braking distance v^2 / 2a (0.59 m at 3.4 m/s^2), not nothing, and told to
+    turn it turns as its turn rate ramps up; without, it stands at once. A turn rate
+    ramps at the angular limit; without a limit it is the commanded one."""
+    cfg = CFG.replace(max_linear_velocity=2.0, max_linear_acceleration=3.4,
+                      max_angular_velocity=4.0, max_angular_acceleration=13.0,
+                      escape_ramps=True)
+    dt = 0.05
+    k = steps(cfg.prediction_horizon, dt)
+    path = driven(np.zeros(3), np.array([0.0]), np.zeros((1, k)), (2.0, 0.0), cfg, dt)[0]
+    assert path[-1, 0] == pytest.approx(2.0 ** 2 / (2 * 3.4), abs=2e-3)
+    assert path[-1, 1] == pytest.approx(0.0, abs=1e-12)
+    at_once = driven(np.zeros(3), np.array([0.0]), np.zeros((1, k)), (2.0, 0.0),
+                     cfg.replace(escape_ramps=False), dt)[0]
+    assert np.abs(at_once).max() == 0.0
+    turning = driven(np.zeros(3), np.array([1.0]), np.full((1, k), 4.0), (1.0, 0.0), cfg,
+                     dt)[0]
+    sharp = driven(np.zeros(3), np.array([1.0]), np.full((1, k), 4.0), (1.0, 0.0),
+                   cfg.replace(escape_ramps=False), dt)[0]
+    assert np.hypot(*turning[2]) > np.hypot(*sharp[2])   # less turned: farther out
+    rate = ramped(0.0, np.full((1, 10), 4.0), 13.0, dt)[0]
+    np.testing.assert_allclose(rate[:6], 13.0 * dt * (np.arange(6) + 0.5))
+    assert rate[-1] == 4.0
+    np.testing.assert_array_equal(ramped(1.0, np.full((1, 3), 4.0), 0.0, dt), 4.0)
 
 
 def test_a_standing_object_and_a_wall_do_not_move():
@@ -471,3 +531,4 @@ def test_chased_towards_a_wall_it_steps_aside_instead_of_running_ahead():
     ahead, _ = halted(pose, rollouts(pose, np.array([CFG.max_linear_velocity]),
                                      np.zeros((1, len(esc.turn))), DT), wall, CFG.robot_radius)
     assert moving_gap(ahead[0], chaser, CFG.robot_radius, DT) < CFG.moving_clearance
+

@@ -256,6 +256,13 @@ class PlannerConfig:
                                  'reverses; the robot backs at up to its top speed: '
                                  'slower, a walker at that speed catches it)', 'm/s', 0.0,
                                  5.0)
+    escape_ramps: bool = param(False, 'Escapes are rolled out changing speed and turn rate '
+                               'from the last command at max_linear_acceleration and '
+                               'max_angular_acceleration (where those are what the base '
+                               'can do, as a robot description states them: a 2 m/s robot '
+                               'brakes over 0.6 m); off: at the commanded rates at once '
+                               '(limits that tune a controller; the escape is sent '
+                               'unlimited)')
     escape_turn_weight: float = param(0.1, 'Among the escapes that keep moving_clearance, '
                                       'the one closest to the planned command wins: '
                                       '|v - v_plan| + this * |w - w_plan| (a difference of '
@@ -348,8 +355,8 @@ def robot_fields(robot: RobotDescription) -> dict[str, float]:
     steps by, scaled by how far the robot goes in one period (RobotDescription.pace:
     the sampling circle, the longest raw step, the slow-down before the goal; 1 for
     the burger, whose figures they are), and its acceleration limits where the robot
-    states them; a robot whose laser does not see behind it never reverses
-    (reverse_speed 0)."""
+    states them (the escapes then rolled out under them); a robot whose laser does not
+    see behind it never reverses (reverse_speed 0)."""
     mount = robot.laser
     pace = robot.pace
     # a polygon: the field keeps the half-width from walls (a gap the robot drives
@@ -375,7 +382,7 @@ def robot_fields(robot: RobotDescription) -> dict[str, float]:
         'sample_radius': round(PlannerConfig.sample_radius * pace, 4),
         'max_step': round(PlannerConfig.max_step * pace, 4),
         'slowdown_distance': round(PlannerConfig.slowdown_distance * pace, 4),
-        **accelerations}
+        'escape_ramps': len(accelerations) == 2, **accelerations}
 
 
 #: The PlannerConfig limits bounded by what the robot can do: field -> the

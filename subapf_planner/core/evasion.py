@@ -4,7 +4,8 @@ obstacles will be, and replaced when it meets one.
 The APF command (core/planner.py) only sees where things are. Each cycle this
 layer rolls the command out for ``prediction_horizon`` seconds (a unicycle at
 constant (v, w), core/rollout.py, in steps of the planning period or a whole fraction of
-it: rollout_step) against each moving track's constant-velocity
+it: rollout_step; with ``escape_ramps``, reaching (v, w) from the last command under the
+acceleration limits) against each moving track's constant-velocity
 prediction (core/tracking.py): the gap between the footprint and the track's
 disc must stay above ``moving_clearance``. When it does not, a small set of
 escape manoeuvres is rolled out the same way (all at once, as arrays): forward,
@@ -36,7 +37,7 @@ from numpy.typing import NDArray
 from scipy.spatial import cKDTree
 
 from .config import PlannerConfig
-from .rollout import arcs, rollouts, steps
+from .rollout import arcs, ramped, rollouts, steps
 from .tracking import Tracks
 
 #: Longest rollout step [s]: the step divides the planning period, so a committed
@@ -99,6 +100,21 @@ def rollout(pose: NDArray[np.float64], v: float, w: float, horizon: float,
     """Positions (k, 2) [m] of a unicycle from ``pose`` (x, y, yaw) at constant (v, w),
     every ``dt`` up to ``horizon`` [s] (first point one step ahead)."""
     return arcs(pose, [v], [w], horizon, dt)[0]
+
+
+def driven(pose: NDArray[np.float64], v: NDArray[np.float64], turn: NDArray[np.float64],
+           previous: tuple[float, float], cfg: PlannerConfig,
+           dt: float) -> NDArray[np.float64]:
+    """Positions (c, k, 2) [m] of the robot from ``pose`` (x, y, yaw) commanded forward
+    speeds v (c,) [m/s] and turn rates turn (c, k) [rad/s] in steps of ``dt`` [s]; with
+    ``escape_ramps``, from the ``previous`` command (v, w) under the acceleration limits
+    (a Jackal at 2 m/s brakes over 0.59 m at 3.4 m/s^2: standing still is not an escape
+    it has at once), else at the commanded rates from the start."""
+    speed = np.repeat(np.asarray(v, float)[:, None], turn.shape[1], axis=1)
+    if cfg.escape_ramps:
+        speed = ramped(previous[0], speed, cfg.max_linear_acceleration, dt)
+        turn = ramped(previous[1], turn, cfg.max_angular_acceleration, dt)
+    return rollouts(pose, speed, turn, dt)
 
 
 def _gaps(paths: NDArray[np.float64], tracks: Tracks, robot_radius: float,
@@ -186,25 +202,30 @@ def candidates(cfg: PlannerConfig) -> list[Escape]:
 
 def evade(pose: NDArray[np.float64], planned: tuple[float, float], tracks: Tracks,
           static: NDArray[np.float64], cfg: PlannerConfig, blocked_ahead: bool,
-          committed: Escape | None = None) -> Escape | None:
+          committed: Escape | None = None,
+          previous: tuple[float, float] | None = None) -> Escape | None:
     """A replacement for the ``planned`` (v, w) when its rollout meets a moving track
     (see the module docstring), or None to keep it. ``static``: the laser points that
     are not moving tracks' (m, 2); ``blocked_ahead``: the safety corridor holds a point
     (forward candidates are then inadmissible); ``committed``: the escape of the last
     cycle, advanced one period, kept while it still keeps the clearance (no dithering
-    between escapes)."""
+    between escapes); ``previous``: the last command (v, w), from which, with
+    ``escape_ramps``, every rollout changes speed and turn rate under the acceleration
+    limits (None: the planned one)."""
     v0, w0 = planned
+    previous = planned if previous is None else previous
     dt, _ = rollout_step(cfg.period)
-    if moving_gap(rollout(pose, v0, w0, cfg.prediction_horizon, dt), tracks,
-                  cfg.robot_radius, dt) >= cfg.moving_clearance:
+    k = steps(cfg.prediction_horizon, dt)
+    if moving_gap(driven(pose, np.array([v0]), np.full((1, k), w0), previous, cfg, dt)[0],
+                  tracks, cfg.robot_radius, dt) >= cfg.moving_clearance:
         return None
     options = candidates(cfg)
-    k = len(options[0].turn)
     if committed is not None and len(committed.turn) == k:
         options.append(committed)
     v = np.array([e.v for e in options])
     turn = np.array([e.turn for e in options])
-    paths, halt = halted(pose, rollouts(pose, v, turn, dt), static, cfg.robot_radius)
+    paths, halt = halted(pose, driven(pose, v, turn, previous, cfg, dt), static,
+                         cfg.robot_radius)
     ok = ~((v > 0.0) & blocked_ahead)
     ok &= (v == 0.0) | (halt >= steps(EVASION_COMMIT, dt))
     if not np.any(ok):

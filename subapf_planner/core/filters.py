@@ -45,7 +45,7 @@ class Evasion(Stage):
         alt = evade(pose, (cmd.v, cmd.w), tracks.ahead(min(cycle.scan_age, MAX_AGE)),
                     points[~tracks.moving_points], cfg,
                     forward_blocked(pose, points, cfg),
-                    None if self._escape is None else self._escape.advanced())
+                    None if self._escape is None else self._escape.advanced(), cycle.previous)
         self._escape = alt
         if alt is None:
             return cycle

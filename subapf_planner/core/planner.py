@@ -36,7 +36,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from .alignment import LOCALISE_TIME, Match, within_drift
-from .blind_spots import blind_obstacles
+from .blind_spots import blind_obstacles, unseen
 from .command import Command
 from .config import PlannerConfig
 from .cycle import Cycle, PlanResult
@@ -433,7 +433,8 @@ class Planner:
         t = scan.stamp if math.isfinite(scan.stamp) else now
         if not self.cfg.tracks_moving or not math.isfinite(t):
             return NO_TRACKS, None, None
-        origin = compose(scan_pose, self.cfg.laser_mount)[:2]
+        laser = compose(scan_pose, self.cfg.laser_mount)
+        origin = laser[:2]
         noise = range_sigma(np.hypot(*(points - origin).T), self.cfg.range_noise_floor,
                             self.cfg.range_noise_fraction)
         beams = np.flatnonzero(scan.valid(self.cfg.obstacle_range))   # those of points
@@ -441,7 +442,8 @@ class Planner:
                                      self.memory.standing(points, origin, 2.0 * noise,
                                                           scans_in(STANDING_TIME,
                                                                    self.cfg.period)),
-                                     beams * scan.beam_interval, noise)
+                                     beams * scan.beam_interval, noise,
+                                     lambda places: unseen(places, laser, scan))
         transient = np.zeros(np.size(scan.ranges), bool)
         transient[beams] = tracks.held_points
         unmoved = np.zeros(np.size(scan.ranges), bool)

@@ -11,7 +11,10 @@ tracked. The others are
 associated with the tracks predicted to this scan's time (Hungarian assignment,
 scipy, within ``track_gate`` and the prediction's uncertainty: GATE_CHI2) and update
 their filter; unmatched clusters start
-tentative tracks, and a track unseen for MAX_MISSES scans is dropped.
+tentative tracks, and a track unseen for MAX_MISSES scans is dropped, but for one that
+moves and is, in part at least, where the lidar cannot see (behind a 270-degree laser,
+within its ``range_min``): it is carried on by its filter for up to COAST_TIME, as
+someone who walks behind the robot is still there.
 
 The filter (per track, vectorised over all tracks) is the constant-velocity
 model: state (x, y, vx, vy) [m, m/s], white-acceleration process noise of
@@ -47,6 +50,7 @@ behind each other and seen again, seemed to move (docs/robots.md).
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -71,8 +75,16 @@ INITIAL_SPEED_SIGMA = 1.0
 #: (static clutter through a realistic lidar). A new track's uncertain velocity still
 #: lets it follow a walker.
 GATE_CHI2 = 5.99
-#: Scans a track may go unseen before it is dropped.
+#: Scans a track may go unseen before it is dropped ...
 MAX_MISSES = 3
+#: ... but a moving track where the lidar cannot see is kept this long unseen [s]
+#: (predicted at its last velocity: a walker at 1.7 m/s behind the Jackal, whose laser
+#: sees nothing in the quarter behind it, was dropped 0.15 s after it left the field of
+#: view and ran into the robot from behind a second later: `crossing_000`).
+COAST_TIME = 2.0
+#: Where an unseen track is looked for: its predicted centre and four places round it
+#: (times its radius grown by its uncertainty); hidden if any of them is.
+PROBES = np.array([[0.0, 0.0], [1.0, 0.0], [-1.0, 0.0], [0.0, 1.0], [0.0, -1.0]])
 #: Scans before a track's speed says whether it moves.
 MIN_HITS = 3
 #: A new object in seen-free space is held out of the memory this many scans.
@@ -234,7 +246,7 @@ class Tracker:
 
     #: Per-track arrays, one row per track, appended and filtered together.
     PER_TRACK = ('x', 'P', 'hits', 'misses', 'new_age', 'radius', 'ids', 'first',
-                 'first_points', 'went', 'moved')
+                 'first_points', 'went', 'moved', 'seen_at')
 
     def __init__(self, gap: float, max_size: float, gate: float, moving_speed: float) -> None:
         self.gap, self.max_size, self.gate, self.moving_speed = gap, max_size, gate, moving_speed
@@ -254,6 +266,7 @@ class Tracker:
         self.first_points = np.zeros((0, FIRST_POINTS, 2))
         self.went = np.zeros(0)          # the farthest it has been from there [m]
         self.moved = np.zeros(0, bool)   # whether it moved at the last scan it was seen
+        self.seen_at = np.zeros(0)       # when it was last seen [s]
         self._next_id = 0
         #: (track ids, points) of the last TRAIL_SCANS scans
         self._history: list[tuple[NDArray[np.int64], NDArray[np.float64]]] = []
@@ -304,14 +317,17 @@ class Tracker:
                log_odds_at: NDArray[np.float64],
                standing: NDArray[np.bool_] | None = None,
                after: NDArray[np.float64] | None = None,
-               sigma: NDArray[np.float64] | None = None) -> Tracks:
+               sigma: NDArray[np.float64] | None = None,
+               hidden: Callable[[NDArray[np.float64]], NDArray[np.bool_]] | None = None
+               ) -> Tracks:
         """Take a scan's obstacle points (n, 2) at time ``t`` [s] with the memory's log
         odds at each (n,; 0 off the map), whether each is on an obstacle that has stood
         STANDING_TIME (n,; none when not given) and how long after ``t`` each was
         taken (n, [s]; a spinning lidar's beam i is i * time_increment after the first:
         a walker seen late in the sweep is measured where it was then; none: all at
         ``t``) and each one's range noise (n, [m]; none: VACATED_RADIUS alone), before
-        the scan is written; returns the tracks, at time ``t``.
+        the scan is written, and which places (k, 2) this scan cannot see (None: it
+        sees all round); returns the tracks, at time ``t``.
         A scan at the same time as the last is not taken again (the tracks stand)."""
         if self.time is not None and t == self.time and self._last is not None:
             return self._last   # the same scan again (a tick without a new one)
@@ -355,6 +371,7 @@ class Tracker:
         seen[track_of[track_of >= 0]] = True
         self.hits[seen] += 1
         self.misses[seen] = 0
+        self.seen_at[seen] = t
         self.misses[~seen] += 1
         self.new_age[seen & (self.new_age >= 0)] += 1
         fresh = [k for k in small if track_of[k] < 0]
@@ -368,10 +385,17 @@ class Tracker:
                          new_age=np.where(new[fresh] >= NEW_FRACTION, 0, -1).astype(np.int64),
                          radius=np.zeros(m), ids=self._next_id + np.arange(m),
                          first=cents[fresh], first_points=_some_points(points, labels, fresh),
-                         went=np.zeros(m),
+                         went=np.zeros(m), seen_at=np.full(m, t),
                          moved=np.zeros(m, bool))
             self._next_id += m
         keep = self.misses <= MAX_MISSES
+        coast = ~keep & self.moved & (t - self.seen_at <= COAST_TIME)
+        if hidden is not None and np.any(coast):
+            # hidden in part: its disc, grown by two standard deviations of where it is
+            reach = self.radius[coast] + 2.0 * np.sqrt(self.P[coast, 0, 0] + self.P[coast, 1, 1])
+            probes = self.x[coast, None, :2] + reach[:, None, None] * PROBES[None]
+            coast[coast] = hidden(probes.reshape(-1, 2)).reshape(len(reach), -1).any(axis=1)
+            keep |= coast
         remap = np.cumsum(keep) - 1
         self._keep(keep)
         if remap.size:
