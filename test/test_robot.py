@@ -65,6 +65,10 @@ def test_the_simulator_is_the_robot_it_is_given():
         assert robot.laser_fov == pytest.approx(cfg.model.fov)   # core's word is sim's
         assert PlannerConfig.for_robot(robot).reverse_speed == (
             robot.max_linear_velocity if robot.sees_all_round else 0.0)
+        # escapes ramped under the accelerations only where they are the base's own
+        assert PlannerConfig.for_robot(robot).escape_ramps == (
+            robot.max_linear_acceleration is not None)
+    assert PlannerConfig.for_robot(ROBOTS['jackal']).escape_ramps
     jackal = SimConfig(robot='jackal')
     assert jackal.beams == 541 and jackal.ranges == (0.5, 20.0)
     assert SimConfig(robot='jackal', max_linear_velocity=1.0).limits == (1.0, 4.0)

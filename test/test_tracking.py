@@ -531,4 +531,3 @@ def test_chased_towards_a_wall_it_steps_aside_instead_of_running_ahead():
     ahead, _ = halted(pose, rollouts(pose, np.array([CFG.max_linear_velocity]),
                                      np.zeros((1, len(esc.turn))), DT), wall, CFG.robot_radius)
     assert moving_gap(ahead[0], chaser, CFG.robot_radius, DT) < CFG.moving_clearance
-
