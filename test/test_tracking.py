@@ -18,11 +18,10 @@ from subapf_planner.core.evasion import (
     halted,
     least_bad,
     moving_gap,
-    rollout,
     rollout_step,
 )
 from subapf_planner.core.planner import Planner
-from subapf_planner.core.rollout import ramped, rollouts, steps
+from subapf_planner.core.rollout import arcs, ramped, rollouts, steps
 from subapf_planner.core.scan import Scan
 from subapf_planner.core.tracking import COAST_TIME, MAX_MISSES, Tracker, Tracks
 
@@ -403,11 +402,11 @@ def test_a_plan_that_keeps_clear_is_kept():
 
 
 def test_rollout_is_a_unicycle():
-    path = rollout(np.array([0.0, 0.0, 0.0]), 0.2, math.pi / 4, 2.0, DT)
+    path = arcs(np.array([0.0, 0.0, 0.0]), [0.2], [math.pi / 4], 2.0, DT)[0]
     # a quarter circle of radius 0.2 / (pi / 4) m
     r = 0.2 / (math.pi / 4)
     np.testing.assert_allclose(path[-1], [r, r], atol=1e-9)
-    np.testing.assert_allclose(rollout(np.array([1.0, 0.0, math.pi]), 0.1, 0.0, 1.0, DT)[-1],
+    np.testing.assert_allclose(arcs(np.array([1.0, 0.0, math.pi]), [0.1], [0.0], 1.0, DT)[0][-1],
                                [0.9, 0.0], atol=1e-12)
 
 

@@ -37,7 +37,7 @@ from numpy.typing import NDArray
 from scipy.spatial import cKDTree
 
 from .config import PlannerConfig
-from .rollout import arcs, ramped, rollouts, steps
+from .rollout import ramped, rollouts, steps
 from .tracking import Tracks
 
 #: Longest rollout step [s]: the step divides the planning period, so a committed
@@ -93,13 +93,6 @@ class Escape:
         """The same manoeuvre one planning period later (its last turn rate held)."""
         m = min(self.per_period, len(self.turn))
         return Escape(self.v, self.turn[m:] + self.turn[-1:] * m, self.per_period)
-
-
-def rollout(pose: NDArray[np.float64], v: float, w: float, horizon: float,
-            dt: float) -> NDArray:
-    """Positions (k, 2) [m] of a unicycle from ``pose`` (x, y, yaw) at constant (v, w),
-    every ``dt`` up to ``horizon`` [s] (first point one step ahead)."""
-    return arcs(pose, [v], [w], horizon, dt)[0]
 
 
 def driven(pose: NDArray[np.float64], v: NDArray[np.float64], turn: NDArray[np.float64],
