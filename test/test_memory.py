@@ -389,7 +389,8 @@ def test_the_memory_says_why_it_holds_no_way():
     ranges, amin, inc, rmin, rmax = enclosure_scan(1.0)
     ranges = ranges.copy()
     ranges[:20] = ranges[-20:] = np.inf      # a ring of radius 1 m, open towards +x
-    mem.integrate(Scan(ranges, amin, inc, rmin, rmax, 0.0), (0.0, 0.0, 0.0))
+    for k in range(3):                       # seen three times: established
+        mem.integrate(Scan(ranges, amin, inc, rmin, rmax, float(k)), (0.0, 0.0, 0.0))
     assert mem.no_way((0.0, 0.0), (0.0, 1.0)) == ('the goal is within inflation_radius of a '
                                                   'wall in the memory, with no free cell '
                                                   'within goal_slack')
@@ -399,9 +400,31 @@ def test_the_memory_says_why_it_holds_no_way():
     field, _ = mem.field_for((0.0, 0.0), (3.0, 0.0), now=1.0)
     assert not field.reachable((0.0, 0.0))
     assert mem.no_way((0.0, 0.0), (3.0, 0.0)) == 'every way through the walls tried'
-    mem.integrate(Scan(*enclosure_scan(1.0), 1.0), (0.0, 0.0, 0.0))   # the ring closes
+    for k in range(3, 6):                    # the ring closes
+        mem.integrate(Scan(*enclosure_scan(1.0), float(k)), (0.0, 0.0, 0.0))
     assert mem.no_way((0.0, 0.0), (3.0, 0.0)) == 'the walls in the memory close every way'
     assert mem.no_way((0.0, 0.0), (30.0, 0.0)).endswith('taken at its edge)')
+
+
+def test_a_goal_is_given_up_only_for_walls_the_memory_is_sure_of():
+    """One return seen once from afar right beside the goal (a mixed pixel at a depth
+    edge) leaves the goal open, and the field leads there to look again; once the return
+    is established (three of them), the goal is closed and the memory says why."""
+    mem = NavigationMemory(PlannerConfig(field_worker=False))
+    n = 360
+    ranges = np.full(n, np.inf)
+    ranges[0] = 3.0                           # straight ahead, 3 m
+    hit = mem.grid.centre_of(mem.grid.cell_of([[3.0 + PlannerConfig().laser_x, 0.0]]))[0]
+    goal = (float(hit[0]), float(hit[1]))
+    for k in range(3):
+        mem.integrate(Scan(ranges, 0.0, 2 * math.pi / n, 0.12, 3.5, float(k)),
+                      (0.0, 0.0, 0.0))
+        assert mem.grid.occupied()[tuple(mem.grid.cell_of([goal])[0])]
+        field, _ = mem.field_for((0.0, 0.0), goal, now=float(k))
+        if k < 2:                             # log odds 0.9, 1.8: not established
+            assert field is not None and field.reachable((0.0, 0.0))
+    assert field is None
+    assert mem.no_way((0.0, 0.0), goal).startswith('the goal is within inflation_radius')
 
 
 def _first_fields(cfg: PlannerConfig) -> NavigationMemory:

@@ -346,6 +346,33 @@ def test_standing_with_no_safe_move_starts_a_recovery_after_blocked_timeout():
     assert len(tried) == 2
 
 
+@pytest.mark.parametrize('turn, marked', [(0.01, True), (0.5, False)])
+def test_blocked_ahead_without_turning_counts_as_standing(turn, marked):
+    """blocked_ahead with no forward speed and hardly a turn (the local target straight
+    ahead in a gap the footprint does not pass) keeps the robot where it is as surely as
+    no_safe_move: the way ahead is marked tried after blocked_timeout. Turning out of
+    it at 0.5 rad/s is no standing."""
+    ctl = DecisionLoop(CFG, Supervision(blocked_timeout=1.0, progress_timeout=10.0,
+                                        recoveries=2))
+    tried = []
+
+    class Mark:
+        def run(self, memory, pose, distance, radius, until):
+            tried.append(until)
+            return True
+    ctl.recoveries.behaviours = (Mark(),)
+    ctl.set_goal(np.array([5.0, 0.0]))
+    ctl.planner.step = lambda *a, **k: PlanResult(Command(0.0, turn, Status.BLOCKED_AHEAD))
+    scan = Scan(np.full(360, np.inf), 0.0, math.pi / 180, 0.12, 3.5, 0.0)
+    texts = []
+    for k in range(20):   # ticks 0.25 s apart, 5 s, the robot standing
+        ctl.update_scan(scan, 0.25 * k)
+        ctl.update_odom(0.25 * k, np.zeros(3), 0.25 * k)
+        texts.append(ctl.tick(0.25 * k).text)
+    assert any('no safe move: the way ahead marked tried' in t for t in texts) is marked
+    assert len(tried) == (2 if marked else 0)
+
+
 def test_goal_unreachable_is_given_up_after_its_timeout_unless_a_way_opens():
     """goal_unreachable for unreachable_timeout ends the attempt (state unreachable,
     zero velocity, and it stays so); a cycle with a way restarts the clock; the same

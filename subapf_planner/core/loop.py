@@ -57,8 +57,9 @@ class Supervision:
     progress_timeout: float = param(10.0, 'Progress checker: time allowed for '
                                     'progress_distance', 's', 1.0, 600.0)
     blocked_timeout: float = param(3.0, 'Progress checker: standing this long with '
-                                   'no_safe_move (the local layer finds no safe sample '
-                                   'where the field leads, nobody to give way to) starts '
+                                   'no_safe_move, or blocked_ahead and not turning (the '
+                                   'local layer finds no safe move where the field leads, '
+                                   'nobody to give way to) starts '
                                    'the recovery without waiting for progress_timeout: a gap '
                                    'that turns out impassable is tried for seconds, not a '
                                    'minute', 's', 0.2, 600.0)

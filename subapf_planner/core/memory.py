@@ -196,7 +196,7 @@ class NavigationMemory:
         """Take the map as it is now for a field to march between cycles
         (start_marching); the next call takes that field."""
         key = self._key(goal)
-        self._due = FieldJob(self._blocked(now), self.grid.origin.copy(), goal, position,
+        self._due = FieldJob(self._blocked(now, goal), self.grid.origin.copy(), goal, position,
                              key, now, self._route_for(key))
 
     def _compute(self, blocked: NDArray[np.bool_], origin: NDArray, goal: NDArray,
@@ -249,7 +249,21 @@ class NavigationMemory:
         self.computations += 1
 
     def _key(self, goal: NDArray) -> tuple:
-        return (tuple(np.round(goal / SAME_GOAL).astype(int)), self.grid.version)
+        """What a field to ``goal`` depends on: the goal, the map's occupied cells, and
+        which of those near the goal are established (_occupied_for)."""
+        box = self._goal_box(goal)
+        sure = 0 if box is None else int(np.count_nonzero(
+            self.grid.log_odds[box] >= ESTABLISHED))
+        return (tuple(np.round(goal / SAME_GOAL).astype(int)), self.grid.version, sure)
+
+    def _goal_box(self, goal: ArrayLike) -> tuple[slice, slice] | None:
+        """The window's cells whose inflation reaches the goal's slack (None: none)."""
+        g = self.grid
+        reach = self.cfg.inflation_radius + self.cfg.goal_slack + g.resolution
+        centre = np.asarray(goal, float)[:2]
+        r0, c0 = np.clip(g.cell_of(centre - reach)[0], 0, g.log_odds.shape)
+        r1, c1 = np.clip(g.cell_of(centre + reach)[0] + 1, 0, g.log_odds.shape)
+        return (slice(r0, r1), slice(c0, c1)) if r0 < r1 and c0 < c1 else None
 
     def integrate(self, scan: Scan, scan_pose: ArrayLike, goal: ArrayLike | None = None,
                   transient: NDArray[np.bool_] | None = None,
@@ -332,9 +346,23 @@ class NavigationMemory:
         self._field_key = None
         self._drop_pending()
 
-    def _blocked(self, now: float | None) -> NDArray[np.bool_]:
-        """The occupied cells plus the avoided places still in force at ``now``."""
+    def _occupied_for(self, goal: ArrayLike) -> NDArray[np.bool_]:
+        """The occupied cells that count for a field to ``goal`` (x, y) [m]: all but those
+        near the goal that are not established (fewer than three returns, ESTABLISHED).
+        A goal is given up only for walls the memory is sure of: a lone return seen once
+        from afar beside the goal (a mixed pixel at a depth edge 12 m away, in a BARN
+        field the Jackal's lidar overlooks) is looked at again from closer, where the
+        field leads, instead of closing the goal until unreachable_timeout."""
         occ = self.grid.occupied()
+        box = self._goal_box(goal)
+        if box is not None:
+            occ[box] &= self.grid.log_odds[box] >= ESTABLISHED
+        return occ
+
+    def _blocked(self, now: float | None, goal: ArrayLike) -> NDArray[np.bool_]:
+        """The cells that count for a field to ``goal`` (_occupied_for) plus the avoided
+        places still in force at ``now``."""
+        occ = self._occupied_for(goal)
         if now is not None:
             self.avoided = [a for a in self.avoided if now < a[3]]
         if not self.avoided:
@@ -359,7 +387,7 @@ class NavigationMemory:
         closed by the walls themselves, or only by places tried (``avoid``). A goal
         beyond the window is taken at its edge (said so)."""
         g = self.grid
-        free, labels = self._hard_free()
+        free, labels = self._hard_free(goal)
         cells = g.cell_of(np.array([position, goal], float).reshape(2, 2))
         beyond = '' if g.inside(cells[1:])[0] else ' (the goal beyond the window, taken ' \
             'at its edge)'
@@ -377,14 +405,15 @@ class NavigationMemory:
             return f'every way through the walls tried{beyond}'
         return f"no way at the field's resolution{beyond}"
 
-    def _hard_free(self) -> tuple[NDArray[np.bool_], NDArray[np.int32]]:
-        """The cells at least ``inflation_radius`` from every occupied cell and their
-        8-connected labels, made once for each state of the map (no_way is asked every
-        cycle the goal is unreachable)."""
+    def _hard_free(self, goal: ArrayLike) -> tuple[NDArray[np.bool_], NDArray[np.int32]]:
+        """The cells at least ``inflation_radius`` from every occupied cell that counts
+        for a field to ``goal`` (_occupied_for) and their 8-connected labels, made once
+        for each state of the map (no_way is asked every cycle the goal is unreachable)."""
         g = self.grid
-        key = (g.version, *g.origin, self.cfg.inflation_radius)
+        key = (g.version, *g.origin, self.cfg.inflation_radius,
+               *np.round(np.asarray(goal, float)[:2] / SAME_GOAL))
         if self._hard_free_cache is None or self._hard_free_cache[0] != key:
-            occ = g.occupied()
+            occ = self._occupied_for(goal)
             clear = ndimage.distance_transform_edt(~occ) * g.resolution if occ.any() \
                 else np.full(occ.shape, np.inf)
             free = clear >= self.cfg.inflation_radius
@@ -460,7 +489,7 @@ class NavigationMemory:
             self._field_key = None   # an avoided place opens again
         key = self._key(g)
         same_goal = self._field_key is not None and self._field_key[0] == key[0]
-        fresh = same_goal and (key[1] == self._field_key[1] or (
+        fresh = same_goal and (key[1:] == self._field_key[1:] or (
             timed and now - self._field_time < self.cfg.field_period))
         covered = self.field is None or self._covers(p)
         if fresh and covered:
@@ -469,7 +498,7 @@ class NavigationMemory:
                 and timed:
             self._march_later(g, p, now)   # only the map's changes: the next call has it
             return self.field, self.computations != installed
-        self._install(self._compute(self._blocked(now if timed else None), self.grid.origin,
+        self._install(self._compute(self._blocked(now if timed else None, g), self.grid.origin,
                                     g, p, self._route_for(key)), key,
                       now if timed else -math.inf)
         return self.field, True

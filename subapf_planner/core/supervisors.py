@@ -11,8 +11,8 @@ Each tick runs them in this order; the first that decides ends the tick:
 * after it (``after``: may decide from the plan): ``arrival`` (``reached``: the goal
   is done), ``unreachable`` (no way to the goal, or the goal inside an obstacle, for
   ``unreachable_timeout``: given up), ``progress`` (the progress checker: no
-  ``progress_distance`` in ``progress_timeout``, or standing with ``no_safe_move`` for
-  ``blocked_timeout``, starts a recovery (core/recovery.py),
+  ``progress_distance`` in ``progress_timeout``, or standing with ``no_safe_move`` (or
+  ``blocked_ahead`` not turning) for ``blocked_timeout``, starts a recovery (core/recovery.py),
   at most ``recoveries`` times a goal, then gives the goal up as stuck; it waits while
   a moving obstacle is within ``giving_way_distance``).
 
@@ -28,6 +28,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from .command import Command
 from .cycle import PlanResult
 from .recovery import AvoidAhead
 from .status import State, Status
@@ -38,6 +39,18 @@ if TYPE_CHECKING:
 #: Statuses under which the goal cannot be reached for now; unreachable_timeout of them
 #: ends the attempt.
 NO_WAY = (Status.GOAL_UNREACHABLE, Status.GOAL_IN_OBSTACLE)
+#: A command held at ``blocked_ahead`` that turns slower than this [rad/s] stands as
+#: surely as ``no_safe_move`` does (the local target straight ahead in a gap the
+#: footprint does not pass: the Jackal's `barn_001` stood so for 10 s, until the
+#: progress checker's clock): it counts towards ``blocked_timeout`` as well.
+STANDING_TURN_RATE = 0.1
+
+
+def standing(command: Command) -> bool:
+    """Whether ``command`` keeps the robot where it is for want of a safe move."""
+    return command.status is Status.NO_SAFE_MOVE or (
+        command.status is Status.BLOCKED_AHEAD and command.v == 0.0
+        and abs(command.w) < STANDING_TURN_RATE)
 
 
 class Supervisor:
@@ -168,7 +181,7 @@ class Progress(Supervisor):
 
     def __init__(self) -> None:
         self._anchor: tuple[np.ndarray, float] | None = None   # where and when it last moved
-        self._blocked_since: float | None = None   # since when it stands with no_safe_move
+        self._blocked_since: float | None = None   # since when it stands (standing)
 
     def restart(self) -> None:
         self._anchor = self._blocked_since = None
@@ -181,7 +194,7 @@ class Progress(Supervisor):
             self._blocked_since = None
             return None   # stopped for a reason of its own: not the progress checker's
         self._move_anchor(loop.pose, lim.progress_distance, now)
-        if cmd.status is not Status.NO_SAFE_MOVE:
+        if not standing(cmd):
             self._blocked_since = None
         elif self._blocked_since is None:
             self._blocked_since = now
