@@ -349,13 +349,16 @@ def test_planner_stops_for_an_enclosed_goal_and_drives_when_it_opens():
     ranges, amin, inc, rmin, rmax = enclosure_scan(1.0)
     ranges = ranges.copy()
     goal = (2.0, 0.0)                            # outside a closed ring of radius ~1 m
-    for k in range(3):
+    for k in range(3):   # the ring seen twice (a cycle plans on the scans before its own)
+        res = planner.step(pose, goal, Scan(ranges, amin, inc, rmin, rmax, k), now=k)
+    assert res.command.status is not Status.GOAL_UNREACHABLE   # not sure of it yet
+    for k in range(3, 5):   # three times and more: established
         res = planner.step(pose, goal, Scan(ranges, amin, inc, rmin, rmax, k), now=k)
     assert res.command.status is Status.GOAL_UNREACHABLE and res.command.v == 0.0
     assert res.no_way == 'the walls in the memory close every way'
     ranges[-30:] = np.inf                        # an opening appears (and stays)
     ranges[:30] = np.inf
-    for k in range(3, 12):
+    for k in range(5, 14):
         res = planner.step(pose, goal, Scan(ranges, amin, inc, rmin, rmax, k), now=k)
     assert res.command.status is not Status.GOAL_UNREACHABLE
 
@@ -400,7 +403,8 @@ def test_the_memory_says_why_it_holds_no_way():
     field, _ = mem.field_for((0.0, 0.0), (3.0, 0.0), now=1.0)
     assert not field.reachable((0.0, 0.0))
     assert mem.no_way((0.0, 0.0), (3.0, 0.0)) == 'every way through the walls tried'
-    for k in range(3, 6):                    # the ring closes
+    for k in range(3, 8):                    # the ring closes (the opening's cells, seen
+        #                                          free three times, established by then)
         mem.integrate(Scan(*enclosure_scan(1.0), float(k)), (0.0, 0.0, 0.0))
     assert mem.no_way((0.0, 0.0), (3.0, 0.0)) == 'the walls in the memory close every way'
     assert mem.no_way((0.0, 0.0), (30.0, 0.0)).endswith('taken at its edge)')

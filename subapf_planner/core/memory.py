@@ -72,13 +72,17 @@ class FieldJob:
     """A navigation field to march between cycles: compute_field's inputs as a cycle
     took them, and what the field is installed as."""
 
-    #: The window's occupied cells and avoided places then (h, w).
+    #: The window's occupied cells and avoided places then (h, w) ...
     blocked: NDArray[np.bool_]
+    #: ... and its established cells and avoided places (the field where the occupied
+    #: ones leave no way: NavigationMemory._compute).
+    sure: NDArray[np.bool_]
     #: The window's corner then (x, y) [m].
     origin: NDArray[np.float64]
     goal: NDArray[np.float64]
     position: NDArray[np.float64]
-    #: (goal cell, map version) the field is for (NavigationMemory._key).
+    #: (goal cell, map version, established cells) the field is for
+    #: (NavigationMemory._key).
     key: tuple
     #: When the cycle took the map [s].
     time: float
@@ -111,6 +115,8 @@ class NavigationMemory:
         #: How long the last field took to compute [s] (wall clock, in the cycle or the
         #: worker: a figure for subapf-perf, not for decisions).
         self.compute_seconds = 0.0
+        #: Whether the occupied cells left no way when the field was made (_compute).
+        self.field_unsure = False
         self._distance: DistanceField | None = None   # the alignment's, and its age
         self._distance_age = 0
         self._hard_free_cache: tuple | None = None   # no_way's free cells, per map state
@@ -181,8 +187,9 @@ class NavigationMemory:
         if self._worker is None:
             self._worker = ThreadPoolExecutor(max_workers=1, thread_name_prefix='field')
             weakref.finalize(self, self._worker.shutdown, wait=False)
-        self._pending = (self._worker.submit(self._compute, job.blocked, job.origin, job.goal,
-                                             job.position, job.route), job)
+        self._pending = (self._worker.submit(self._compute, job.blocked, job.sure,
+                                             job.origin, job.goal, job.position, job.route),
+                         job)
 
     def settle(self) -> None:
         """Start the field due and wait until it is done; the next call takes it as it
@@ -196,28 +203,41 @@ class NavigationMemory:
         """Take the map as it is now for a field to march between cycles
         (start_marching); the next call takes that field."""
         key = self._key(goal)
-        self._due = FieldJob(self._blocked(now, goal), self.grid.origin.copy(), goal, position,
+        self._due = FieldJob(*self._blocked(now), self.grid.origin.copy(), goal, position,
                              key, now, self._route_for(key))
 
-    def _compute(self, blocked: NDArray[np.bool_], origin: NDArray, goal: NDArray,
-                 position: NDArray, route: Route | None
-                 ) -> tuple[NavigationField | None, float, NDArray | None]:
-        """The field, how long it took [s], and, with route_discount, its descent from
-        ``position`` (the route the next field favours)."""
+    def _compute(self, blocked: NDArray[np.bool_], sure: NDArray[np.bool_], origin: NDArray,
+                 goal: NDArray, position: NDArray, route: Route | None
+                 ) -> tuple[NavigationField | None, float, NDArray | None, bool]:
+        """The field, how long it took [s], with route_discount its descent from
+        ``position`` (the route the next field favours), and whether the ``blocked``
+        cells left no way (the field is then the one over the ``sure`` cells if that has
+        one): where the ``blocked`` ones leave no way from ``position``, the
+        field leads through cells that are occupied but not established (a return or two:
+        a mixed pixel, a noisy far return, something seen once at the edge of the
+        laser's reach) to look at them again, if the established ones leave a way. A goal
+        is given up only for walls the memory is sure of."""
         cfg = self.cfg
         t0 = time.perf_counter()
-        field = compute_field(blocked, origin, self.grid.resolution, goal, position,
-                              inflation_radius=cfg.inflation_radius,
-                              clearance_band=cfg.inflation_band,
-                              coarsening=cfg.field_coarsening,
-                              route=None if route is None else route.points,
-                              route_discount=0.0 if route is None else route.discount,
-                              route_width=0.0 if route is None else route.width,
-                              gap_clearance=cfg.gap_clearance, goal_slack=cfg.goal_slack)
+
+        def march(cells: NDArray[np.bool_]) -> NavigationField | None:
+            return compute_field(cells, origin, self.grid.resolution, goal, position,
+                                 inflation_radius=cfg.inflation_radius,
+                                 clearance_band=cfg.inflation_band,
+                                 coarsening=cfg.field_coarsening,
+                                 route=None if route is None else route.points,
+                                 route_discount=0.0 if route is None else route.discount,
+                                 route_width=0.0 if route is None else route.width,
+                                 gap_clearance=cfg.gap_clearance, goal_slack=cfg.goal_slack)
+        field, unsure = march(blocked), False
+        if field is None or not field.reachable(position):
+            other, unsure = march(sure), True
+            if other is not None and other.reachable(position):
+                field = other
         seconds = time.perf_counter() - t0
         if field is None or cfg.route_discount <= 0.0 or self.path is not None:
-            return field, seconds, None
-        return field, seconds, field.path(position, ROUTE_LENGTH)
+            return field, seconds, None, unsure
+        return field, seconds, field.path(position, ROUTE_LENGTH), unsure
 
     def _route_for(self, key: tuple) -> Route | None:
         """The route a field for ``key`` favours: a path given to follow, else the last
@@ -240,30 +260,21 @@ class NavigationMemory:
         self._field_key = None
         self._drop_pending()
 
-    def _install(self, computed: tuple[NavigationField | None, float, NDArray | None],
+    def _install(self, computed: tuple[NavigationField | None, float, NDArray | None, bool],
                  key: tuple, when: float) -> None:
-        self.field, self.compute_seconds, route = computed
+        self.field, self.compute_seconds, route, self.field_unsure = computed
         self._field_key, self._field_time = key, when
         self.route, self._route_goal = (None, None) if route is None or not len(route) \
             else (route, key[0])
         self.computations += 1
 
     def _key(self, goal: NDArray) -> tuple:
-        """What a field to ``goal`` depends on: the goal, the map's occupied cells, and
-        which of those near the goal are established (_occupied_for)."""
-        box = self._goal_box(goal)
-        sure = 0 if box is None else int(np.count_nonzero(
-            self.grid.log_odds[box] >= ESTABLISHED))
+        """What a field to ``goal`` depends on: the goal, the map's occupied cells, and,
+        while there is no field or the occupied cells left no way (_compute), how many are
+        established."""
+        sure = int(np.count_nonzero(self.grid.log_odds >= ESTABLISHED)) \
+            if self.field is None or self.field_unsure else -1
         return (tuple(np.round(goal / SAME_GOAL).astype(int)), self.grid.version, sure)
-
-    def _goal_box(self, goal: ArrayLike) -> tuple[slice, slice] | None:
-        """The window's cells whose inflation reaches the goal's slack (None: none)."""
-        g = self.grid
-        reach = self.cfg.inflation_radius + self.cfg.goal_slack + g.resolution
-        centre = np.asarray(goal, float)[:2]
-        r0, c0 = np.clip(g.cell_of(centre - reach)[0], 0, g.log_odds.shape)
-        r1, c1 = np.clip(g.cell_of(centre + reach)[0] + 1, 0, g.log_odds.shape)
-        return (slice(r0, r1), slice(c0, c1)) if r0 < r1 and c0 < c1 else None
 
     def integrate(self, scan: Scan, scan_pose: ArrayLike, goal: ArrayLike | None = None,
                   transient: NDArray[np.bool_] | None = None,
@@ -346,23 +357,15 @@ class NavigationMemory:
         self._field_key = None
         self._drop_pending()
 
-    def _occupied_for(self, goal: ArrayLike) -> NDArray[np.bool_]:
-        """The occupied cells that count for a field to ``goal`` (x, y) [m]: all but those
-        near the goal that are not established (fewer than three returns, ESTABLISHED).
-        A goal is given up only for walls the memory is sure of: a lone return seen once
-        from afar beside the goal (a mixed pixel at a depth edge 12 m away, in a BARN
-        field the Jackal's lidar overlooks) is looked at again from closer, where the
-        field leads, instead of closing the goal until unreachable_timeout."""
-        occ = self.grid.occupied()
-        box = self._goal_box(goal)
-        if box is not None:
-            occ[box] &= self.grid.log_odds[box] >= ESTABLISHED
-        return occ
+    def _blocked(self, now: float | None) -> tuple[NDArray[np.bool_], NDArray[np.bool_]]:
+        """The occupied cells, and the established ones, each with the avoided places
+        still in force at ``now`` (_compute)."""
+        return (self._avoided_in(self.grid.occupied(), now),
+                self._avoided_in(self.grid.log_odds >= ESTABLISHED, None))
 
-    def _blocked(self, now: float | None, goal: ArrayLike) -> NDArray[np.bool_]:
-        """The cells that count for a field to ``goal`` (_occupied_for) plus the avoided
-        places still in force at ``now``."""
-        occ = self._occupied_for(goal)
+    def _avoided_in(self, occ: NDArray[np.bool_], now: float | None) -> NDArray[np.bool_]:
+        """``occ`` with the avoided places still in force at ``now`` blocked (None: as
+        they are)."""
         if now is not None:
             self.avoided = [a for a in self.avoided if now < a[3]]
         if not self.avoided:
@@ -387,7 +390,7 @@ class NavigationMemory:
         closed by the walls themselves, or only by places tried (``avoid``). A goal
         beyond the window is taken at its edge (said so)."""
         g = self.grid
-        free, labels = self._hard_free(goal)
+        free, labels = self._hard_free()
         cells = g.cell_of(np.array([position, goal], float).reshape(2, 2))
         beyond = '' if g.inside(cells[1:])[0] else ' (the goal beyond the window, taken ' \
             'at its edge)'
@@ -405,15 +408,15 @@ class NavigationMemory:
             return f'every way through the walls tried{beyond}'
         return f"no way at the field's resolution{beyond}"
 
-    def _hard_free(self, goal: ArrayLike) -> tuple[NDArray[np.bool_], NDArray[np.int32]]:
-        """The cells at least ``inflation_radius`` from every occupied cell that counts
-        for a field to ``goal`` (_occupied_for) and their 8-connected labels, made once
-        for each state of the map (no_way is asked every cycle the goal is unreachable)."""
+    def _hard_free(self) -> tuple[NDArray[np.bool_], NDArray[np.int32]]:
+        """The cells at least ``inflation_radius`` from every established cell (the walls
+        that close a goal: _compute) and their 8-connected labels, made once for each
+        state of the map (no_way is asked every cycle the goal is unreachable)."""
         g = self.grid
-        key = (g.version, *g.origin, self.cfg.inflation_radius,
-               *np.round(np.asarray(goal, float)[:2] / SAME_GOAL))
+        sure = g.log_odds >= ESTABLISHED
+        key = (g.version, int(np.count_nonzero(sure)), *g.origin, self.cfg.inflation_radius)
         if self._hard_free_cache is None or self._hard_free_cache[0] != key:
-            occ = self._occupied_for(goal)
+            occ = sure
             clear = ndimage.distance_transform_edt(~occ) * g.resolution if occ.any() \
                 else np.full(occ.shape, np.inf)
             free = clear >= self.cfg.inflation_radius
@@ -498,7 +501,7 @@ class NavigationMemory:
                 and timed:
             self._march_later(g, p, now)   # only the map's changes: the next call has it
             return self.field, self.computations != installed
-        self._install(self._compute(self._blocked(now if timed else None, g), self.grid.origin,
+        self._install(self._compute(*self._blocked(now if timed else None), self.grid.origin,
                                     g, p, self._route_for(key)), key,
                       now if timed else -math.inf)
         return self.field, True
