@@ -315,11 +315,10 @@ def test_goal_behind_a_wall_without_progress_becomes_stuck():
     assert ctl.tick(4.0).command == (0.0, 0.0)
 
 
-def test_standing_with_no_safe_move_starts_a_recovery_after_blocked_timeout():
-    """A gap the local layer finds no safe sample into: the way ahead is marked tried
-    after blocked_timeout of no_safe_move (a cycle that moves restarts that clock), not
-    after progress_timeout; with no recovery left, the goal is given up only on the
-    progress checker's own clock."""
+def _standing_ticks(command, ticks: int) -> tuple[list[str], list[float]]:
+    """``ticks`` ticks 0.25 s apart of a robot that stands where it is while the plan
+    says ``command()`` (blocked_timeout 1 s, progress_timeout 10 s, two recoveries that
+    only count themselves): each tick's text, and the times the recoveries hold until."""
     ctl = DecisionLoop(CFG, Supervision(blocked_timeout=1.0, progress_timeout=10.0,
                                         recoveries=2))
     tried = []
@@ -330,14 +329,23 @@ def test_standing_with_no_safe_move_starts_a_recovery_after_blocked_timeout():
             return True
     ctl.recoveries.behaviours = (Mark(),)
     ctl.set_goal(np.array([5.0, 0.0]))
-    script = iter([Status.NO_SAFE_MOVE] * 4 + [Status.DRIVING] + [Status.NO_SAFE_MOVE] * 100)
-    ctl.planner.step = lambda *a, **k: PlanResult(Command(0.0, 0.0, next(script)))
+    ctl.planner.step = lambda *a, **k: PlanResult(command())
     scan = Scan(np.full(360, np.inf), 0.0, math.pi / 180, 0.12, 3.5, 0.0)
     texts = []
-    for k in range(100):   # ticks 0.25 s apart, the robot standing
+    for k in range(ticks):
         ctl.update_scan(scan, 0.25 * k)
         ctl.update_odom(0.25 * k, np.zeros(3), 0.25 * k)
         texts.append(ctl.tick(0.25 * k).text)
+    return texts, tried
+
+
+def test_standing_with_no_safe_move_starts_a_recovery_after_blocked_timeout():
+    """A gap the local layer finds no safe sample into: the way ahead is marked tried
+    after blocked_timeout of no_safe_move (a cycle that moves restarts that clock), not
+    after progress_timeout; with no recovery left, the goal is given up only on the
+    progress checker's own clock."""
+    script = iter([Status.NO_SAFE_MOVE] * 4 + [Status.DRIVING] + [Status.NO_SAFE_MOVE] * 100)
+    texts, tried = _standing_ticks(lambda: Command(0.0, 0.0, next(script)), 100)
     marked = [k for k, t in enumerate(texts) if 'marked tried' in t]
     assert marked == [10, 16]        # more than 1 s of no_safe_move from tick 5, and again
     assert texts[10] == 'driving: no safe move: the way ahead marked tried (1 of 2), another way'
@@ -352,23 +360,7 @@ def test_blocked_ahead_without_turning_counts_as_standing(turn, marked):
     ahead in a gap the footprint does not pass) keeps the robot where it is as surely as
     no_safe_move: the way ahead is marked tried after blocked_timeout. Turning out of
     it at 0.5 rad/s is no standing."""
-    ctl = DecisionLoop(CFG, Supervision(blocked_timeout=1.0, progress_timeout=10.0,
-                                        recoveries=2))
-    tried = []
-
-    class Mark:
-        def run(self, memory, pose, distance, radius, until):
-            tried.append(until)
-            return True
-    ctl.recoveries.behaviours = (Mark(),)
-    ctl.set_goal(np.array([5.0, 0.0]))
-    ctl.planner.step = lambda *a, **k: PlanResult(Command(0.0, turn, Status.BLOCKED_AHEAD))
-    scan = Scan(np.full(360, np.inf), 0.0, math.pi / 180, 0.12, 3.5, 0.0)
-    texts = []
-    for k in range(20):   # ticks 0.25 s apart, 5 s, the robot standing
-        ctl.update_scan(scan, 0.25 * k)
-        ctl.update_odom(0.25 * k, np.zeros(3), 0.25 * k)
-        texts.append(ctl.tick(0.25 * k).text)
+    texts, tried = _standing_ticks(lambda: Command(0.0, turn, Status.BLOCKED_AHEAD), 20)
     assert any('no safe move: the way ahead marked tried' in t for t in texts) is marked
     assert len(tried) == (2 if marked else 0)
 

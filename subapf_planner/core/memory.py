@@ -211,12 +211,11 @@ class NavigationMemory:
                  ) -> tuple[NavigationField | None, float, NDArray | None, bool]:
         """The field, how long it took [s], with route_discount its descent from
         ``position`` (the route the next field favours), and whether the ``blocked``
-        cells left no way (the field is then the one over the ``sure`` cells if that has
-        one): where the ``blocked`` ones leave no way from ``position``, the
-        field leads through cells that are occupied but not established (a return or two:
-        a mixed pixel, a noisy far return, something seen once at the edge of the
-        laser's reach) to look at them again, if the established ones leave a way. A goal
-        is given up only for walls the memory is sure of."""
+        cells left no way from ``position``. Where they leave none, the field is the one
+        over the ``sure`` cells if that has a way: it leads through cells occupied but
+        not established (a return or two: a mixed pixel, a noisy far return, something
+        seen once at the edge of the laser's reach) to look at them again. A goal is
+        given up only for walls the memory is sure of."""
         cfg = self.cfg
         t0 = time.perf_counter()
 
