@@ -103,6 +103,24 @@ def test_a_corridor_the_rectangle_fits_is_open_to_it_and_closed_to_its_disc():
 
 
 @pytest.mark.sim
+def test_a_sample_the_forward_check_would_stop_at_is_not_taken():
+    """A gap 0.52 m wide for the Jackal (0.43 m), its right side 0.6 m ahead and 0.2 m
+    to the right, its left beside the robot 0.33 m to the left: the sample straight
+    ahead keeps the polygon clear where it stands, but the way there runs into the
+    gap's right side within the command's forward check; a sample a little to the left
+    leads in. (Taken straight ahead, the robot stood with blocked_ahead: `barn_001`.)"""
+    cfg = PlannerConfig.for_robot(JACKAL)
+    left = np.column_stack((np.linspace(-0.3, 0.3, 13), np.full(13, 0.33)))
+    right = np.column_stack((np.linspace(0.57, 0.9, 8), np.full(8, -0.2)))
+    points = np.vstack((left, right))
+    samples = np.array([[0.22, 0.0], [0.22, 0.05]])
+    clear = np.min(np.hypot(*(samples[:, None] - points[None]).transpose(2, 0, 1)), axis=1)
+    assert not cfg.polygon.contact(np.column_stack((samples, np.arctan2(*samples.T[::-1]))),
+                                   points, cfg.sample_clearance - cfg.robot_radius).any()
+    assert forward_blocked(np.zeros(3), points, cfg)
+    assert safe_samples(samples, clear, np.zeros(2), points, cfg).tolist() == [False, True]
+
+
 @pytest.mark.parametrize('key, door', [('jackal', 0.6), ('waffle_pi', 0.42)])
 def test_a_rectangle_passes_a_door_its_circumscribed_disc_cannot(key, door):
     """The simulated robot (its real rectangle) and a door narrower than the circle that

@@ -111,6 +111,17 @@ class Footprint:
             return np.zeros(p.shape[0], bool)
         return np.any(near & np.all(self._outside(fx, fy) <= margin, axis=-1), axis=1)
 
+    def corridor(self, poses: ArrayLike, points: ArrayLike, reach: float) -> NDArray[np.bool_]:
+        """For each pose (n, 3), whether a point (m, 2) lies ahead of it within the
+        footprint's half-width and closer than ``reach`` [m] (the command's forward
+        check, core/command.py forward_blocked, for each pose)."""
+        p = np.atleast_2d(np.asarray(poses, float))
+        pts = np.asarray(points, float).reshape(-1, 2)
+        if pts.shape[0] == 0:
+            return np.zeros(p.shape[0], bool)
+        fx, fy = self._in_frames(p, pts)
+        return np.any((fx > 0.0) & (np.abs(fy) <= self.half_width) & (fx < reach), axis=1)
+
     def gaps(self, poses: ArrayLike, points: ArrayLike) -> NDArray[np.float64]:
         """How far each point (m, 2) lies outside the footprint placed at each pose (n, 3)
         (n, m) [m]: the largest of its distances outside the edges' lines, which is the

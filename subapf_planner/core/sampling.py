@@ -95,13 +95,22 @@ def safe_samples(samples: NDArray[np.float64], clear: NDArray[np.float64],
     obstacle point; with a footprint polygon and the memory's field, instead those where
     the polygon, placed on the sample facing the way the robot drives there from
     ``position``, keeps sample_clearance - robot_radius from every point
-    (core/footprint.py)."""
+    (core/footprint.py), and whose way from ``position`` the command's forward check
+    (core/command.py forward_blocked) leaves open: a sample straight ahead in a gap
+    the footprint passes only a few centimetres to one side was chosen, and the
+    robot stood with blocked_ahead where a sample to that side would have led it in
+    (the Jackal's `barn_001`)."""
     shape = cfg.polygon
     if shape is None or not cfg.geodesic:
         return clear > cfg.discard_distance
     way = samples - np.asarray(position, float)
-    poses = np.column_stack((samples, np.arctan2(way[:, 1], way[:, 0])))
-    return ~shape.contact(poses, obstacles, cfg.sample_clearance - cfg.robot_radius)
+    heading = np.arctan2(way[:, 1], way[:, 0])
+    poses = np.column_stack((samples, heading))
+    start = np.column_stack((np.broadcast_to(np.asarray(position, float)[:2],
+                                             samples.shape), heading))
+    reach = shape.front + cfg.safety_distance - cfg.robot_radius
+    return ~shape.contact(poses, obstacles, cfg.sample_clearance - cfg.robot_radius) \
+        & ~shape.corridor(start, obstacles, reach)
 
 
 def sample_and_choose(raw_point: ArrayLike, position: ArrayLike, goal: ArrayLike,
