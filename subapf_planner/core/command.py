@@ -60,17 +60,21 @@ def forward_blocked(pose: ArrayLike, obstacles: ArrayLike, cfg: PlannerConfig) -
     corridor |y| <= robot_radius and closer than safety_distance to the centre; with a
     footprint polygon, within its half-width and closer than safety_distance -
     robot_radius to its front."""
+    shape = cfg.polygon
+    if shape is not None:
+        return bool(shape.corridor(pose, obstacles, corridor_reach(cfg))[0])
     fx, fy = _robot_frame(pose, obstacles)
     if fx.size == 0:
         return False
-    shape = cfg.polygon
-    if shape is not None:
-        reach = shape.front + cfg.safety_distance - cfg.robot_radius
-        hit = (fx > 0.0) & (np.abs(fy) <= shape.half_width) & (fx < reach)
-        return bool(np.any(hit))
     hit = (fx > 0.0) & (np.abs(fy) <= cfg.robot_radius) & (np.hypot(fx, fy)
                                                              < cfg.safety_distance)
     return bool(np.any(hit))
+
+
+def corridor_reach(cfg: PlannerConfig) -> float:
+    """How far ahead of a footprint polygon's origin the forward check looks [m]: its
+    front plus safety_distance - robot_radius."""
+    return cfg.polygon.front + cfg.safety_distance - cfg.robot_radius
 
 
 def backward_blocked(pose: ArrayLike, obstacles: ArrayLike, cfg: PlannerConfig) -> bool:

@@ -26,6 +26,7 @@ import math
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from .command import corridor_reach
 from .config import PlannerConfig
 from .critics import Critic, Samples, make_critics
 from .navigation import NavigationField
@@ -108,9 +109,8 @@ def safe_samples(samples: NDArray[np.float64], clear: NDArray[np.float64],
     poses = np.column_stack((samples, heading))
     start = np.column_stack((np.broadcast_to(np.asarray(position, float)[:2],
                                              samples.shape), heading))
-    reach = shape.front + cfg.safety_distance - cfg.robot_radius
     return ~shape.contact(poses, obstacles, cfg.sample_clearance - cfg.robot_radius) \
-        & ~shape.corridor(start, obstacles, reach)
+        & ~shape.corridor(start, obstacles, corridor_reach(cfg))
 
 
 def sample_and_choose(raw_point: ArrayLike, position: ArrayLike, goal: ArrayLike,
