@@ -1,7 +1,10 @@
-"""Planner node in one process: parameters, safety stops, cmd_vel type (rclpy executor)."""
+"""Planner node in one process: parameters, safety stops, cmd_vel type (rclpy executor);
+the simulator node's start held for its listeners."""
 
 import math
+import time
 
+from conftest import WORLDS
 from geometry_msgs.msg import PoseStamped, Twist, TwistStamped
 from nav_msgs.msg import Odometry
 import numpy as np
@@ -11,6 +14,7 @@ import rclpy
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.parameter import Parameter
 from rclpy.qos import QoSProfile, qos_profile_sensor_data
+from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import LaserScan, TimeReference
 from std_msgs.msg import String
 
@@ -18,6 +22,7 @@ from subapf_planner.core.scan import Scan
 from subapf_planner.ros.conversions import odom_to_msg, scan_to_msg
 from subapf_planner.ros.planner_node import PlannerNode
 from subapf_planner.ros.qos import LATCHED as LATCHED_QOS
+from subapf_planner.ros.sim_node import SimNode
 
 pytestmark = pytest.mark.node
 
@@ -495,3 +500,38 @@ def test_spin_node_waits_without_polling_and_a_signal_wakes_it():
             signal.signal(s, h)
     assert sent and shut and shut[0] - sent[0] < 1.0
     assert spins and set(spins) == {None} and len(spins) <= 2
+
+
+def test_the_simulator_waits_for_its_listeners_when_asked(ros):
+    """start_subscribers: the simulation stays at time 0 until /clock has that many
+    subscribers and odom and scan one each (subapf-bringup: the planner and its
+    recording), then runs; a replay then has every message from the first."""
+    sim = SimNode(context=ros, parameter_overrides=[
+        Parameter('world', value=str(WORLDS / 'cluttered_field.yaml')),
+        Parameter('start_subscribers', value=2)])
+    peer = rclpy.create_node('listener', context=ros)
+    try:
+        def matched(n):
+            end = time.monotonic() + 10.0
+            while time.monotonic() < end:   # DDS matches on its own threads
+                if sim.clock_pub.get_subscription_count() >= n \
+                        and sim.odom_pub.get_subscription_count() >= 1 \
+                        and sim.scan_pub.get_subscription_count() >= 1:
+                    return True
+                time.sleep(0.01)
+            return False
+        peer.create_subscription(Clock, '/clock', lambda _m: None, 10)
+        peer.create_subscription(Odometry, 'odom', lambda _m: None, 10)
+        peer.create_subscription(LaserScan, 'scan', lambda _m: None, qos_profile_sensor_data)
+        assert matched(1)
+        for _ in range(3):
+            sim._on_timer()
+        assert sim.sim.time == 0.0   # one /clock subscriber of two: held
+        peer.create_subscription(Clock, '/clock', lambda _m: None, 10)
+        assert matched(2)
+        sim._on_timer()
+        assert sim.sim.time > 0.0
+    finally:
+        peer.destroy_node()
+        sim.destroy_node()
+        sim.close()

@@ -102,6 +102,11 @@ class SimNodeOptions:
                                10.0, read_only=True)
     map_error_yaw: float = param(0.0, "The localiser's error in map -> odom (yaw)", 'rad',
                                  -3.15, 3.15, read_only=True)
+    start_subscribers: int = param(0, 'Hold the simulation at time 0 until /clock has this '
+                                   'many subscribers, and odom and scan one each (a node on '
+                                   'simulated time and a recorder each subscribe /clock: the '
+                                   'run starts when they listen, none of its first messages '
+                                   'lost); 0: start at once', '', 0, 100, read_only=True)
 
     def __post_init__(self) -> None:
         check_fields(self)
@@ -148,6 +153,7 @@ class SimNode(Node):
         self.create_subscription(PoseStamped, 'goal_pose', self._on_goal, 10)
         self.attempts = Attempts(self.world)
         self._next_scan = 0.0
+        self._start_subscribers = options.start_subscribers
         # Fast mode: several ticks per timer callback, so the executor's overhead per
         # callback does not cap the speed-up.
         self.ticks_per_call = max(1, int(round(MIN_TIMER_PERIOD * options.rate / TICK)))
@@ -191,6 +197,14 @@ class SimNode(Node):
                 f't={a.start:.1f} s, time limit {self.world.time_limit:g} s')
 
     def _on_timer(self) -> None:
+        if self._start_subscribers:   # held at time 0 until enough listen
+            if self.clock_pub.get_subscription_count() < self._start_subscribers \
+                    or not self.odom_pub.get_subscription_count() \
+                    or not self.scan_pub.get_subscription_count():
+                return
+            self.get_logger().info(f'{self.clock_pub.get_subscription_count()} subscribers '
+                                   'to /clock: simulating')
+            self._start_subscribers = 0
         for _ in range(self.ticks_per_call):
             self._on_tick()
 

@@ -46,10 +46,21 @@ RECORDED = {
     '/subapf_planner/map': (OccupancyGrid, _LATCHED_DEEP),
     '/moving_obstacles': (MarkerArray, _RELIABLE),
 }
+CLOCK = '/clock'
 #: Longest the recorder drains its queues on close [s].
 DRAIN_TIMEOUT = 5.0
 #: Recorded only when asked for by name (--record-topics): the map is 160 kB a message.
 ON_REQUEST = {'/subapf_planner/map'}
+#: Recorded topics a replay needs from the first message: their recording waits for a
+#: publisher (when recorded).
+NEEDED = ('/scan', '/odom', '/cmd_vel', '/subapf_planner/taken')
+#: /clock's subscribers the simulator waits for (sim_node start_subscribers; and one
+#: each on odom and scan: the planner's): the planner's and the supervisor's, which
+#: subscribes once its recording listens.
+START_SUBSCRIBERS = 2
+#: Longest wait for the recording to listen to every publisher before the run starts
+#: anyway (with a warning) [s, wall].
+LISTEN_TIMEOUT = 30.0
 
 
 class Supervisor:
@@ -76,13 +87,45 @@ class Supervisor:
         self.node.create_subscription(String, '/sim_outcome', self._on_outcome, LATCHED)
         self.node.create_subscription(Odometry, '/ground_truth', self._on_truth, 10)
         self.node.create_subscription(String, '/subapf_planner/status', self._on_status, 10)
-        if self.recorder is not None:
-            for topic, (msg_type, qos) in RECORDED.items():
-                if topic not in (record_topics or set(RECORDED) - ON_REQUEST):
-                    continue
+        #: The recording's subscriptions but /clock's, which starts the run (_start).
+        self._recorded: dict[str, object] = {}
+        self._clock = None
+        chosen = (record_topics or set(RECORDED) - ON_REQUEST) if record else ()
+        self._record_clock = CLOCK in chosen
+        for topic, (msg_type, _) in RECORDED.items():
+            if topic in chosen:
                 self.recorder.add_topic(topic, type_name_of(msg_type))
-                self.node.create_subscription(msg_type, topic, self._recording(topic), qos,
-                                              raw=True)
+                if topic != CLOCK:
+                    self._recorded[topic] = self._subscribe(topic)
+
+    def _subscribe(self, topic: str):
+        msg_type, qos = RECORDED[topic]
+        return self.node.create_subscription(msg_type, topic, self._recording(topic), qos,
+                                             raw=True)
+
+    def _listening(self) -> bool:
+        """Whether each recording subscription has matched every publisher of its topic
+        (and those a replay needs at least one)."""
+        return all(sub.get_publisher_count() >= max(int(topic in NEEDED),
+                                                     self.node.count_publishers(topic))
+                   for topic, sub in self._recorded.items())
+
+    def _start(self, since: float) -> None:
+        """Subscribe /clock (recorded or not) once the recording listens to every
+        publisher, or LISTEN_TIMEOUT after ``since``: the simulator, waiting for
+        START_SUBSCRIBERS on /clock, starts the run then."""
+        if self._clock is not None:
+            return
+        listening = self._listening()
+        if not listening and time.monotonic() - since < LISTEN_TIMEOUT:
+            return
+        if not listening:
+            deaf = sorted(t for t, sub in self._recorded.items() if sub.get_publisher_count()
+                          < max(int(t in NEEDED), self.node.count_publishers(t)))
+            print(f'subapf-bringup: the recording does not hear {deaf} after '
+                  f'{LISTEN_TIMEOUT:g} s; starting anyway', flush=True)
+        self._clock = self._subscribe(CLOCK) if self._record_clock else \
+            self.node.create_subscription(Clock, CLOCK, lambda _msg: None, 10)
 
     def _recording(self, topic: str):
         def write(data: bytes) -> None:
@@ -115,7 +158,8 @@ class Supervisor:
         """Spin until the simulator reports an outcome (for ``reached``: and the planner
         has stopped driving, or ARRIVAL_WAIT later), a child dies, or the timeout.
         Samples each named child's resident memory once a second into ``rss_mib``."""
-        deadline = time.monotonic() + timeout
+        started = time.monotonic()
+        deadline = started + timeout
         goal_sent_at = None
         arrived_at = None
         next_sample = time.monotonic()
@@ -127,6 +171,7 @@ class Supervisor:
                 for name, child in zip(names, children, strict=True):
                     self.rss_mib.setdefault(name, []).append(rss_mib(child.pid))
             rclpy.spin_once(self.node, timeout_sec=0.05)
+            self._start(started)
             if self.outcome == 'reached' and self.status.startswith('driving'):
                 arrived_at = arrived_at or time.monotonic()   # it drives on to the goal
                 if time.monotonic() - arrived_at < ARRIVAL_WAIT:

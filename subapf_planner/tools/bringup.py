@@ -256,6 +256,7 @@ def run_once(world: World, world_path: str, params: str | tuple[str, ...], domai
     The nodes' output goes to the terminal, or to ``log_dir``/{sim,planner,foxglove}.log.
     """
     env = join_domain(domain)
+    from ..ros import supervisor  # rclpy only after join_domain
     files = (params,) if isinstance(params, str) else tuple(params)
     planner_args = [arg for f in files for arg in ('--params-file', f)]
     planner_args += ['-p', 'use_sim_time:=true']
@@ -263,14 +264,14 @@ def run_once(world: World, world_path: str, params: str | tuple[str, ...], domai
         planner_args += ['-p', f'method:={method}']
     stamped = str(ROBOTS[robot].stamped_cmd_vel).lower()   # the base takes what it takes
     sim_args = ['-p', f'world:={world_path}', '-p', f'rate:={rate}', '-p', f'seed:={seed}',
-                '-p', f'robot:={robot}', '-p', f'enable_stamped_cmd_vel:={stamped}']
+                '-p', f'robot:={robot}', '-p', f'enable_stamped_cmd_vel:={stamped}',
+                '-p', f'start_subscribers:={supervisor.START_SUBSCRIBERS}']
     for name, value in (sim_params or {}).items():
         sim_args += ['-p', f'{name}:={value}']
-    timeout = timeout or 2.0 * world.time_limit / rate + 30.0
+    timeout = timeout or 2.0 * world.time_limit / rate + 30.0 + supervisor.LISTEN_TIMEOUT
     if method is None:
         method = load_params_file(files[0]).get('method', METHODS[0])
 
-    from ..ros.supervisor import Supervisor  # rclpy only after the environment is set
     children: list[subprocess.Popen] = []
     sup = None
     nodes = {'sim_node': sim_args, 'planner_node': planner_args}
@@ -279,7 +280,7 @@ def run_once(world: World, world_path: str, params: str | tuple[str, ...], domai
     try:
         children = [start(node, node_args, env, log=log_dir / f'{node.split("_")[0]}.log'
                           if log_dir else None) for node, node_args in nodes.items()]
-        sup = Supervisor(world, record, method, record_topics)
+        sup = supervisor.Supervisor(world, record, method, record_topics)
         outcome = sup.run(children, timeout, names=tuple(nodes))
     except KeyboardInterrupt:   # before the supervisor took over the signals
         outcome = 'interrupted'
