@@ -103,12 +103,12 @@ class Supervisor:
         return self.node.create_subscription(msg_type, topic, self._recording(topic), qos,
                                              raw=True)
 
-    def _listening(self) -> bool:
-        """Whether each recording subscription has matched every publisher of its topic
-        (and those a replay needs at least one)."""
-        return all(sub.get_publisher_count() >= max(int(topic in NEEDED),
-                                                     self.node.count_publishers(topic))
-                   for topic, sub in self._recorded.items())
+    def _deaf(self) -> list[str]:
+        """The recorded topics whose subscription has not matched every publisher of the
+        topic yet (or, for those a replay needs, none)."""
+        return sorted(topic for topic, sub in self._recorded.items()
+                      if sub.get_publisher_count() < max(int(topic in NEEDED),
+                                                         self.node.count_publishers(topic)))
 
     def _start(self, since: float) -> None:
         """Subscribe /clock (recorded or not) once the recording listens to every
@@ -116,12 +116,10 @@ class Supervisor:
         START_SUBSCRIBERS on /clock, starts the run then."""
         if self._clock is not None:
             return
-        listening = self._listening()
-        if not listening and time.monotonic() - since < LISTEN_TIMEOUT:
+        deaf = self._deaf()
+        if deaf and time.monotonic() - since < LISTEN_TIMEOUT:
             return
-        if not listening:
-            deaf = sorted(t for t, sub in self._recorded.items() if sub.get_publisher_count()
-                          < max(int(t in NEEDED), self.node.count_publishers(t)))
+        if deaf:
             print(f'subapf-bringup: the recording does not hear {deaf} after '
                   f'{LISTEN_TIMEOUT:g} s; starting anyway', flush=True)
         self._clock = self._subscribe(CLOCK) if self._record_clock else \
