@@ -21,7 +21,7 @@ from subapf_planner.core.evasion import (
     rollout_step,
 )
 from subapf_planner.core.planner import Planner
-from subapf_planner.core.rollout import along, arcs, ramped, rollouts, steps
+from subapf_planner.core.rollout import arcs, ramped, rollouts, steps
 from subapf_planner.core.scan import Scan
 from subapf_planner.core.tracking import COAST_TIME, MAX_MISSES, Tracker, Tracks
 
@@ -399,45 +399,6 @@ def test_a_plan_that_keeps_clear_is_kept():
     # straight ahead into a walker coming the other way: replaced by one that keeps clear
     alt = evade(pose, (0.2, 0.0), head_on(0.2, 1.0), np.zeros((0, 2)), CFG, False)
     assert alt is not None and alt.command != (0.2, 0.0)
-
-
-def test_a_turn_that_circles_clear_of_a_walker_on_a_route_across_its_way_is_replaced():
-    """Heading up a route that crosses a walker's way, the command turns hard (it would
-    circle clear of the walker if held): rolled out along the route at its speed it
-    meets the walker, so the robot evades; without the route the turn looks clear."""
-    pose = np.array([0.0, 0.0, math.pi / 2])
-    walker = Tracks(np.array([[1.6, 0.7]]), np.array([[-0.8, 0.0]]), np.array([0.25]),
-                    np.array([True]), np.array([True]), np.zeros(0, np.int64))
-    turn = (0.2, CFG.max_angular_velocity)
-    route = np.array([[0.0, 0.0], [0.0, 4.0]])
-    assert evade(pose, turn, walker, np.zeros((0, 2)), CFG, False) is None
-    alt = evade(pose, turn, walker, np.zeros((0, 2)), CFG, False, way=route)
-    assert alt is not None
-    # a route away from the walker leaves the command as it is
-    assert evade(pose, turn, walker, np.zeros((0, 2)), CFG, False,
-                 way=np.array([[0.0, 0.0], [0.0, -4.0]])) is None
-
-
-def test_a_fast_mover_is_given_room_by_its_speed():
-    """A mover passing a standing robot 0.2 m clear of its footprint: at walking pace
-    that is room enough, at 2 m/s (where a track's place and velocity are a fraction of
-    a second of its motion uncertain) the robot gets out of its way."""
-    pose = np.array([0.0, 0.0, 0.0])
-    lane = CFG.robot_radius + 0.25 + 0.2
-
-    def passing(speed):
-        return Tracks(np.array([[-1.0, lane]]), np.array([[speed, 0.0]]), np.array([0.25]),
-                      np.array([True]), np.array([True]), np.zeros(0, np.int64))
-    assert evade(pose, (0.0, 0.0), passing(0.5), np.zeros((0, 2)), CFG, False) is None
-    assert evade(pose, (0.0, 0.0), passing(2.0), np.zeros((0, 2)), CFG, False) is not None
-
-
-def test_along_a_route_the_robot_moves_at_its_speed_and_stands_at_the_end():
-    way = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0]])
-    p = along(way, np.full(8, 0.5), 0.5)
-    assert np.allclose(p[:4], [[0.25, 0.0], [0.5, 0.0], [0.75, 0.0], [1.0, 0.0]])
-    assert np.allclose(p[4:], [[1.0, 0.25], [1.0, 0.5], [1.0, 0.75], [1.0, 1.0]])
-    assert np.allclose(along(way, np.full(3, 2.0), 1.0), [[1.0, 1.0]] * 3)
 
 
 def test_rollout_is_a_unicycle():

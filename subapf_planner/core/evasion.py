@@ -5,12 +5,9 @@ The APF command (core/planner.py) only sees where things are. Each cycle this
 layer rolls the command out for ``prediction_horizon`` seconds (a unicycle at
 constant (v, w), core/rollout.py, in steps of the planning period or a whole fraction of
 it: rollout_step; with ``escape_ramps``, reaching (v, w) from the last command under the
-acceleration limits), and along the navigation field's route ahead at its speed (where
-the robot goes on to: a turn that seems to circle clear of a walker's way begins a route
-across it), against each moving track's constant-velocity
+acceleration limits) against each moving track's constant-velocity
 prediction (core/tracking.py): the gap between the footprint and the track's
-disc, widened by SPEED_MARGIN seconds of the track's motion, must stay above
-``moving_clearance``. When it does not, a small set of
+disc must stay above ``moving_clearance``. When it does not, a small set of
 escape manoeuvres is rolled out the same way (all at once, as arrays): forward,
 slower, standing still and backing up at ``reverse_speed`` (the burger backs at
 up to 0.22 m/s), each straight or turning, for the whole horizon or for a while
@@ -40,7 +37,7 @@ from numpy.typing import NDArray
 from scipy.spatial import cKDTree
 
 from .config import PlannerConfig
-from .rollout import along, ramped, rollouts, steps
+from .rollout import ramped, rollouts, steps
 from .tracking import Tracks
 
 #: Longest rollout step [s]: the step divides the planning period, so a committed
@@ -68,10 +65,6 @@ HYSTERESIS = 0.02
 #: velocity estimate: beside slow walkers the choice flipped between driving on and
 #: backing up, cycle after cycle).
 TOUCH_HYSTERESIS = 0.4
-#: A moving track's predicted disc is wider by its speed times this [s]: the
-#: uncertainty of where a fast mover is (its centroid shifts with the side the lidar
-#: sees, its velocity with each scan) is a fraction of a second of its motion.
-SPEED_MARGIN = 0.15
 
 
 def rollout_step(period: float) -> tuple[float, int]:
@@ -128,8 +121,7 @@ def _gaps(paths: NDArray[np.float64], tracks: Tracks, robot_radius: float,
     t = (np.arange(paths.shape[1]) + 1)[:, None] * dt                         # (k, 1)
     where = tracks.position[m][None] + t[..., None] * tracks.velocity[m][None]   # (k, n, 2)
     d = paths[:, :, None, :] - where[None]                                      # (c, k, n, 2)
-    radius = tracks.radius[m] + SPEED_MARGIN * np.hypot(*tracks.velocity[m].T)
-    gap = np.hypot(d[..., 0], d[..., 1]) - radius - robot_radius
+    gap = np.hypot(d[..., 0], d[..., 1]) - tracks.radius[m] - robot_radius
     return gap.min(axis=2)
 
 
@@ -201,28 +193,10 @@ def candidates(cfg: PlannerConfig) -> list[Escape]:
     return out
 
 
-def planned_paths(pose: NDArray[np.float64], planned: tuple[float, float],
-                  previous: tuple[float, float], cfg: PlannerConfig, dt: float, k: int,
-                  way: NDArray[np.float64] | None = None) -> NDArray[np.float64]:
-    """Where the ``planned`` (v, w) takes the robot (c, k, 2) in ``k`` steps of ``dt``
-    [s]: held as an arc, and, with ``way`` (the route ahead from the robot, (n, 2)),
-    along that route at the planned speed (a turning command that seems to circle
-    clear of a walker's way is the start of a route across it)."""
-    v0, w0 = planned
-    arc = driven(pose, np.array([v0]), np.full((1, k), w0), previous, cfg, dt)
-    if way is None or len(way) < 2:
-        return arc
-    speed = np.full((1, k), v0)
-    if cfg.escape_ramps:
-        speed = ramped(previous[0], speed, cfg.max_linear_acceleration, dt)
-    return np.concatenate((arc, along(way, speed[0], dt)[None]))
-
-
 def evade(pose: NDArray[np.float64], planned: tuple[float, float], tracks: Tracks,
           static: NDArray[np.float64], cfg: PlannerConfig, blocked_ahead: bool,
           committed: Escape | None = None,
-          previous: tuple[float, float] | None = None,
-          way: NDArray[np.float64] | None = None) -> Escape | None:
+          previous: tuple[float, float] | None = None) -> Escape | None:
     """A replacement for the ``planned`` (v, w) when its rollout meets a moving track
     (see the module docstring), or None to keep it. ``static``: the laser points that
     are not moving tracks' (m, 2); ``blocked_ahead``: the safety corridor holds a point
@@ -230,15 +204,13 @@ def evade(pose: NDArray[np.float64], planned: tuple[float, float], tracks: Track
     cycle, advanced one period, kept while it still keeps the clearance (no dithering
     between escapes); ``previous``: the last command (v, w), from which, with
     ``escape_ramps``, every rollout changes speed and turn rate under the acceleration
-    limits (None: the planned one); ``way``: the route ahead from the robot (n, 2) [m],
-    along which the planned speed is rolled out too (planned_paths; None: the arc
-    only)."""
+    limits (None: the planned one)."""
     v0, w0 = planned
     previous = planned if previous is None else previous
     dt, _ = rollout_step(cfg.period)
     k = steps(cfg.prediction_horizon, dt)
-    if np.all(moving_gaps(planned_paths(pose, planned, previous, cfg, dt, k, way), tracks,
-                          cfg.robot_radius, dt) >= cfg.moving_clearance):
+    if moving_gap(driven(pose, np.array([v0]), np.full((1, k), w0), previous, cfg, dt)[0],
+                  tracks, cfg.robot_radius, dt) >= cfg.moving_clearance:
         return None
     options = candidates(cfg)
     if committed is not None and len(committed.turn) == k:

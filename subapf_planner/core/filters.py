@@ -3,8 +3,7 @@ it (core/cycle.py).
 
 * ``evasion`` (with the tracker, for the APF methods): the command is rolled out
   against where the moving tracks will be (carried forward from the scan's time to
-  the cycle's), and so is the navigation field's route ahead at the command's speed;
-  the command is replaced by an escape when either would meet one (core/evasion.py);
+  the cycle's) and replaced by an escape when it would meet one (core/evasion.py);
   the chosen escape is committed, so the next cycle weighs it again one period on.
   Not once the goal is reached.
 """
@@ -23,19 +22,6 @@ from .status import Status
 #: The tracks are carried forward to the cycle's time by at most this [s] (a scan older
 #: than the scan timeout stops the robot anyway).
 MAX_AGE = 1.0
-
-
-def _way(cycle: Cycle) -> np.ndarray | None:
-    """The navigation field's route from the robot as far as it can drive within the
-    prediction horizon (None without a field, or off it)."""
-    field, cfg = cycle.field, cycle.cfg
-    if field is None:
-        return None
-    route = field.path(cycle.pose[:2], cfg.max_linear_velocity * cfg.prediction_horizon
-                       + field.resolution)
-    if len(route) < 2:
-        return None
-    return np.vstack((cycle.pose[:2], route[1:]))
 
 
 class Evasion(Stage):
@@ -59,8 +45,7 @@ class Evasion(Stage):
         alt = evade(pose, (cmd.v, cmd.w), tracks.ahead(min(cycle.scan_age, MAX_AGE)),
                     points[~tracks.moving_points], cfg,
                     forward_blocked(pose, points, cfg),
-                    None if self._escape is None else self._escape.advanced(), cycle.previous,
-                    _way(cycle))
+                    None if self._escape is None else self._escape.advanced(), cycle.previous)
         self._escape = alt
         if alt is None:
             return cycle

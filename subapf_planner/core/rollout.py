@@ -61,16 +61,3 @@ def arcs(pose: ArrayLike, v: ArrayLike, w: ArrayLike, horizon: float,
     every ``dt`` up to ``horizon`` [s] (first point one step ahead)."""
     w = np.asarray(w, float)
     return rollouts(pose, v, np.repeat(w[:, None], steps(horizon, dt), axis=1), dt)
-
-
-def along(way: ArrayLike, speed: ArrayLike, dt: float) -> NDArray[np.float64]:
-    """Positions (k, 2) [m] of a robot that follows the polyline ``way`` (n, 2) from its
-    first point at the speeds ``speed`` (k,) [m/s], one per step of ``dt`` [s] (the first
-    point one step ahead); it stands at the end of the way once there (and at its start
-    for a way of one point)."""
-    p = np.asarray(way, float).reshape(-1, 2)
-    s = np.cumsum(np.maximum(np.asarray(speed, float), 0.0) * dt)
-    if len(p) < 2:
-        return np.repeat(p[:1], len(s), axis=0)
-    length = np.concatenate(([0.0], np.cumsum(np.hypot(*np.diff(p, axis=0).T))))
-    return np.column_stack((np.interp(s, length, p[:, 0]), np.interp(s, length, p[:, 1])))
