@@ -198,12 +198,11 @@ class SimNode(Node):
 
     def _on_timer(self) -> None:
         if self._start_subscribers:   # held at time 0 until enough listen
-            if self.clock_pub.get_subscription_count() < self._start_subscribers \
-                    or not self.odom_pub.get_subscription_count() \
-                    or not self.scan_pub.get_subscription_count():
+            clocked = self.clock_pub.get_subscription_count()
+            if clocked < self._start_subscribers or not listened(self.odom_pub) \
+                    or not listened(self.scan_pub):
                 return
-            self.get_logger().info(f'{self.clock_pub.get_subscription_count()} subscribers '
-                                   'to /clock: simulating')
+            self.get_logger().info(f'{clocked} subscribers to /clock: simulating')
             self._start_subscribers = 0
         for _ in range(self.ticks_per_call):
             self._on_tick()
