@@ -505,27 +505,46 @@ def test_a_walls_end_is_found_and_returns_beyond_it_do_not_pull():
 
 
 @pytest.mark.core
-def test_with_the_alignment_the_robot_stands_until_its_first_walls_are_established():
-    """The memory's frame is odom at the start: the first FIRST_SCANS scans are taken
-    standing (``mapping``, a stop), so that a first turn's drift is not drawn into the
-    walls everything after is matched to. Without the alignment it drives at once."""
-    from subapf_planner.core.gates import FIRST_SCANS
+def test_with_the_alignment_the_robot_stands_until_its_walls_hold_a_match():
+    """The memory's frame is odom at the start: the robot stands (``mapping``, a stop)
+    until the memory holds FIRST_SCANS scans and a scan has been matched to its walls, so
+    that a first turn is matched as it is made and its drift is not drawn into the walls
+    everything after is matched to; then it drives, and standing does not come back.
+    Where the scan holds too few returns for a match it stands FIRST_SCANS scans, where
+    its returns hold none (nothing stands still in them) MAPPING_TIME at most. Without
+    the alignment it drives at once."""
+    from subapf_planner.core.gates import FIRST_SCANS, MAPPING_TIME
     from subapf_planner.core.status import Status
     walls = room()
-    for aligned in (True, False):
+    period = 0.2
+    rng = np.random.default_rng(3)
+    for aligned, seen in ((True, 'room'), (True, 'nothing'), (True, 'shuffled'),
+                          (False, 'room')):
         planner = Planner(PlannerConfig(scan_alignment=aligned, laser_x=0.0, laser_y=0.0,
                                         laser_yaw=0.0))
-        statuses = []
-        for k in range(FIRST_SCANS + 1):
-            scan = Scan(ranges_from(walls, (0.0, 0.0, 0.0)), 0.0, math.radians(1.0), 0.12,
-                        3.5, 0.2 * (k + 1))
-            r = planner.step(np.zeros(3), (2.0, -1.0), scan, now=0.2 * (k + 1))
+        statuses, matched = [], []
+        for k in range(15):
+            ranges = {'room': lambda: ranges_from(walls, (0.0, 0.0, 0.0)),
+                      'nothing': lambda: np.full(360, np.inf),
+                      'shuffled': lambda: rng.uniform(0.5, 3.0, 360)}[seen]()
+            scan = Scan(ranges, 0.0, math.radians(1.0), 0.12, 3.5, period * (k + 1))
+            r = planner.step(np.zeros(3), (2.0, -1.0), scan, now=period * (k + 1))
             statuses.append(r.command.status)
+            matched.append(planner.aligned)
             if r.command.status is Status.MAPPING:
                 assert (r.command.v, r.command.w) == (0.0, 0.0)
         mapping = [s is Status.MAPPING for s in statuses]
-        assert mapping == ([True] * (FIRST_SCANS - 1) + [False] * 2 if aligned
-                           else [False] * (FIRST_SCANS + 1))
+        if not aligned:
+            assert not any(mapping)
+            continue
+        stood = mapping.index(False)
+        assert not any(mapping[stood:])   # once over, never again
+        if seen == 'room':   # walls established by three hits: the fourth scan matched
+            assert stood > FIRST_SCANS and matched[stood] and not matched[stood - 1]
+        else:
+            assert not any(matched)
+            assert stood == (FIRST_SCANS - 1 if seen == 'nothing'
+                             else round(MAPPING_TIME / period))
 
 
 @pytest.mark.core

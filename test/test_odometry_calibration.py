@@ -10,6 +10,7 @@ import pytest
 from test_alignment import room, seen_from, segment
 
 from subapf_planner.core.odometry_calibration import (
+    MIN_SAMPLES,
     OdometryCalibration,
     register,
     scaled,
@@ -85,6 +86,18 @@ def test_a_drive_round_a_room_learns_the_wheels_scales():
 
 
 @pytest.mark.core
+def test_one_registration_does_not_set_a_scale():
+    """A scale is taken once MIN_SAMPLES samples of it have been: with odometry 5 % long
+    and turning 5 % too far, the first metre round the room (two or three samples of
+    each) leaves both scales at 1; the rest of the drive learns them."""
+    poses = circle((-0.5, 0.0), 1.2)
+    (k_d, k_y), samples = drive(room(), poses[:26], (1.05, 1.05))
+    assert 0 < max(samples) < MIN_SAMPLES and (k_d, k_y) == (1.0, 1.0)
+    (k_d, k_y), samples = drive(room(), poses, (1.05, 1.05))
+    assert min(samples) >= MIN_SAMPLES and k_d < 0.97 and k_y < 0.97
+
+
+@pytest.mark.core
 def test_a_featureless_corridor_teaches_the_distance_nothing():
     """Two parallel walls, nothing across: a registration there fixes the pose across
     the corridor, not along it, and the distance scale stays within 0.5 % of 1 while
@@ -118,7 +131,7 @@ def test_a_turn_is_corrected_by_its_registration_before_anything_is_learnt():
     odom_b = np.array(compose(a, scaled(compose(invert(a), b), (1.0, 1.03))))
     predicted = odom_b   # odom is the memory's frame here
     cal.observe(seen_from(walls, b, seed=4), odom_b)
-    assert cal.scales[1] < 1.0   # a sample taken
+    assert cal.samples[1] == 1 and cal.scales[1] == 1.0   # a sample, not yet a scale
     assert abs(predicted[2] - b[2]) > 0.02
     corrected = cal.correct(predicted)
     assert abs(corrected[2] - b[2]) < 0.005 and np.hypot(*(corrected[:2] - b[:2])) < 0.01

@@ -88,6 +88,9 @@ class Cycle:
     previous: tuple[float, float]
     #: Scans in the memory, this cycle's counted (0 without the memory).
     memory_scans: int = 0
+    #: Whether a scan has been matched to the memory's walls (the scan alignment's match
+    #: accepted at least once since the memory began).
+    aligned: bool = False
     #: How old the scan is [s] (now minus its stamp; 0 when unknown).
     scan_age: float = 0.0
     #: The navigation field (None: the Euclidean attraction) and whether it is new.

@@ -6,7 +6,8 @@ In the order :func:`~subapf_planner.core.pipeline.stage_names` runs them:
   approach is over: see :class:`Goal`) or inside an obstacle (a laser point within
   ``robot_radius`` of it);
 * ``mapping`` (with the scan alignment): the robot stands until the memory holds its
-  first scans, so that the memory's frame is odom at the start;
+  first scans and its walls hold a match of the scan to them, so that the memory's
+  frame is odom at the start and a first turn is matched as it is made;
 * ``reachability`` (with the memory): the navigation field to the goal, and
   ``goal_unreachable`` when the memory holds no way to it.
 """
@@ -18,6 +19,7 @@ import math
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from .alignment import MIN_MATCHED
 from .config import PlannerConfig
 from .cycle import Cycle, Stage
 from .memory import NavigationMemory
@@ -25,9 +27,15 @@ from .sampling import clearance
 from .status import Status
 
 #: With the scan alignment, the robot stands until the memory holds this many scans
-#: (the occupancy grid's walls are established by three hits), for this many cycles at
-#: most (a scan repeated with the same stamp is not taken twice).
+#: (the occupancy grid's walls are established by three hits) and, unless the scan holds
+#: too few returns for a match (alignment.MIN_MATCHED: a hall wider than the lidar's
+#: reach), a scan's match to the memory has been accepted: through the LDS-01's noise a
+#: wall's returns scatter over several cells, three scans establish too few of them, and
+#: a first turn made before the walls hold a match kept its drift for the whole run
+#: (docs/alignment.md) ...
 FIRST_SCANS = 3
+#: ... for this long at most [s] (what is seen may hold no match).
+MAPPING_TIME = 2.0
 #: Inside goal_tolerance the approach goes on while the robot gets this much closer to the
 #: goal than it has been [m] at least once every ARRIVAL_PATIENCE [s]: a cycle or two
 #: spent turning towards the goal (a few centimetres off its axis the heading to it is
@@ -103,20 +111,33 @@ class Goal(Stage):
 
 
 class Mapping(Stage):
-    """``mapping`` while the memory holds fewer than FIRST_SCANS scans, for FIRST_SCANS
-    cycles at most; not once the robot is inside the goal tolerance."""
+    """``mapping`` while the memory holds fewer than FIRST_SCANS scans (for FIRST_SCANS
+    cycles at most: a scan repeated with the same stamp is not taken twice) or, while the
+    scan holds enough returns for a match, none has been matched to its walls yet
+    (Cycle.aligned); MAPPING_TIME at most from the first cycle it stood; not once the
+    robot is inside the goal tolerance. Once over, it does not come back for the same
+    memory."""
 
     name = 'mapping'
 
     def __init__(self) -> None:
+        self._since: float | None = None   # when it first stood [s]
         self._cycles = 0   # cycles stood so far
+        self._over = False
 
     def forget(self) -> None:
-        self._cycles = 0
+        self._since, self._cycles, self._over = None, 0, False
 
     def run(self, cycle: Cycle) -> Cycle:
-        if cycle.goal_distance <= cycle.cfg.goal_tolerance \
-                or cycle.memory_scans >= FIRST_SCANS or self._cycles >= FIRST_SCANS:
+        if self._over or cycle.goal_distance <= cycle.cfg.goal_tolerance:
+            return cycle
+        if self._since is None:
+            self._since = cycle.now
+        first = cycle.memory_scans >= FIRST_SCANS or self._cycles >= FIRST_SCANS
+        matchable = np.count_nonzero(np.isfinite(cycle.points).all(axis=1)) >= MIN_MATCHED
+        if (first and (cycle.aligned or not matchable)) \
+                or cycle.now - self._since >= MAPPING_TIME:
+            self._over = True
             return cycle
         self._cycles += 1
         return cycle.with_(status=Status.MAPPING)

@@ -193,6 +193,8 @@ class Planner:
         #: The memory's frame in odom: the scan alignment's correction (x, y, yaw).
         self.correction: tuple[float, float, float] = (0.0, 0.0, 0.0)
         self.match: Match | None = None          # the last scan's alignment
+        #: Whether a scan's match has been accepted since the memory began.
+        self.aligned = False
         self._aligned_stamp: float | None = None
         self._aligned_from: NDArray | None = None   # odom pose of the last scan matched
         #: Scans left to match in a localiser's basin (start_from; alignment.localise).
@@ -259,6 +261,7 @@ class Planner:
         cycle = Cycle(cfg, now, cfg.period, pose, goal, points, tracks=tracks,
                       previous=self.previous,
                       memory_scans=self.memory.grid.scans + (self._perception is not None),
+                      aligned=self.aligned,
                       scan_age=now - scan.stamp if math.isfinite(scan.stamp) else 0.0,
                       **_situation(pose, goal, obstacles))
         result = self._run_stages(cycle)
@@ -333,6 +336,7 @@ class Planner:
             self._localising -= 1
             self.match = self.memory.align(base, predicted, discs, wide=True)
             if self.match.accepted:
+                self.aligned = True
                 self._localising = 0
                 self._place(self.match.pose, scan_pose)
                 return
@@ -347,6 +351,7 @@ class Planner:
                 predicted = within_drift(predicted, self.odometry.correct(predicted),
                                          distance, turn)
         self.match = self.memory.align(base, predicted, discs)
+        self.aligned = self.aligned or self.match.accepted
         pose = predicted
         if moved is not None and self.match.accepted:
             pose = within_drift(predicted, self.match.pose, distance, turn)

@@ -28,9 +28,10 @@ class Status(StrEnum):
     INVALID_SCAN = 'invalid_scan'
     INVALID_POSE = 'invalid_pose'
     INVALID_GOAL = 'invalid_goal'
-    #: The scan alignment's memory is new (fewer than planner.FIRST_SCANS scans): the
-    #: robot stands while the first walls are established, so that the memory's frame is
-    #: odom at the start, not odom turned by the drift of a first turn.
+    #: The scan alignment's memory is new (fewer than gates.FIRST_SCANS scans, or none
+    #: matched to its walls yet): the robot stands while the first walls are established,
+    #: so that the memory's frame is odom at the start and a first turn is matched as it
+    #: is made, not drawn into the walls with its drift.
     MAPPING = 'mapping'
 
     @property
@@ -53,7 +54,8 @@ class State(StrEnum):
     #: A goal, but no scan or no odometry yet.
     WAITING = 'waiting'
     #: The normal first state of a goal with the scan alignment: the robot stands for the
-    #: first scans of a new memory (core/gates.py Mapping, FIRST_SCANS cycles at most).
+    #: first scans of a new memory, until one is matched to its walls (core/gates.py
+    #: Mapping, MAPPING_TIME at most).
     MAPPING = 'mapping'
     DRIVING = 'driving'
     #: Held still for a reason that can pass (a stale input, no safe move, no way yet).
