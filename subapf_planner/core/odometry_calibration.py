@@ -20,9 +20,11 @@ once). Each registration is
   displacement along odometry's direction of motion against odometry's distance, each
   with the variance the returns' information gives that direction (INFLATION for
   their errors being correlated, floored). The scales are the weighted least-squares
-  fit of all samples and a prior of 1 (PRIOR_SIGMA); a sample more than OUTLIER from 1
-  is a failed registration, not a wheel. A corridor, which fixes a registration
-  across it and not along it, gives a turn sample and hardly a distance one;
+  fit of all samples and a prior of 1 (PRIOR_SIGMA), each taken once it rests on
+  MIN_SAMPLES samples (1 before: one registration among people can be 1.5 % off); a
+  sample more than OUTLIER from 1 is a failed registration, not a wheel. A corridor,
+  which fixes a registration across it and not along it, gives a turn sample and
+  hardly a distance one;
 * a correction of the pose predicted for that scan (:meth:`OdometryCalibration.correct`):
   where the registration puts it from the keyframe's place, fused with the prediction
   by their covariances. Before anything is learnt, a robot's first turn (3 % of a
