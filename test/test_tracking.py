@@ -249,59 +249,6 @@ def test_a_cluster_on_what_has_long_stood_never_moves_whatever_its_centroid_does
     assert not moved_when(True)
 
 
-def test_a_walker_first_seen_against_a_post_has_left_once_it_walked_off():
-    """A walker first seen touching a post (one cluster) that the memory holds, in
-    part, as established: the place its track was first seen at is its own returns
-    then, not the post's established ones (tracking.FIRST_POINTS): once it walked off
-    (its own returns do not count), the post that still returns there does not hold
-    the place. Kept with all the post's returns, the place was more the post's than the
-    walker's and the walker never left it (`clutter_walkers_010` of the moving suite:
-    the walker walked into the robot)."""
-    from subapf_planner.core.tracking import _still_there
-    post = disc_points((2.0, 0.0), 0.12, n=30)
-    odds = np.zeros(30)
-    odds[5:25] = 3.0   # its middle on established obstacles
-    walker = disc_points((2.0, 0.47), 0.25, n=16)
-    tr = Tracker(0.15, 1.2, 0.6, 0.04)
-    tr.update(np.vstack((post, walker)), 0.0, np.concatenate((odds, np.zeros(16))))
-    assert len(tr.first_points) == 1
-    first = tr.first_points[0][np.isfinite(tr.first_points[0, :, 0])]
-    assert np.hypot(*(first[:, None] - post[odds > 0][None]).transpose(2, 0, 1)).min() > 0
-    assert not _still_there(first, post, None)
-    assert _still_there(np.vstack((post, walker))[::3], post, None)
-
-
-def scans_a_slow_walker_is_not_a_mover(seed: int) -> int:
-    """A walker (disc of radius 0.25 m) shuffling at 0.05 m/s, seen for 12 s with 1.5 cm
-    of noise and a fifth of its returns dropped: after it is first known to move, how
-    many scans it is not."""
-    rng = np.random.default_rng(seed)
-    tr = Tracker(0.15, 1.2, 0.6, 0.04)
-    known, lapses = False, 0
-    for k in range(60):
-        pts = disc_points((2.0 + 0.05 * 0.2 * k, 1.0), 0.25)
-        pts = pts[rng.random(len(pts)) > 0.2]
-        pts = pts + rng.normal(0.0, 0.015, pts.shape)
-        moving = tr.update(pts, 0.2 * k, np.zeros(len(pts))).moving.any()
-        known |= moving
-        lapses += known and not moving
-    return lapses
-
-
-def test_a_slow_walker_stays_a_mover_while_its_estimated_speed_dips(monkeypatch):
-    """Once it moved, a track stays moving down to KEEP_SPEED_FRACTION of moving_speed:
-    a slow walker's estimate dips below moving_speed between scans (6 runs: at most
-    one scan in each that it is not a mover; measured 3 in all). Held to moving_speed
-    (KEEP_SPEED_FRACTION 1), it lapsed 4-6 scans a run (at least 3 asserted), and
-    where it lapsed it was a wall (`clutter_walkers_009` of the moving suite: it
-    walked into the robot)."""
-    from subapf_planner.core import tracking
-    lapses = [scans_a_slow_walker_is_not_a_mover(seed) for seed in range(6)]
-    monkeypatch.setattr(tracking, 'KEEP_SPEED_FRACTION', 1.0)
-    held = [scans_a_slow_walker_is_not_a_mover(seed) for seed in range(6)]
-    assert max(lapses) <= 1 and min(held) >= 3, (lapses, held)
-
-
 def scans_with_a_mover_beside_a_wall(seed: int) -> int:
     """Of 50 scans a robot takes driving 2.2 m at 0.22 m/s along a wall 2.7 m beside it,
     through the LDS-01's noise (2.5 % of the range: 7-9 cm at the wall) with a fifth of

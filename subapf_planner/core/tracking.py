@@ -24,14 +24,12 @@ operations for every track at once; filterpy's per-object KalmanFilter costs a
 Python object per track per step for the same equations.
 
 A track **moves** when it has been seen MIN_HITS times, its estimated speed is
-at least ``moving_speed`` (KEEP_SPEED_FRACTION of it once it moved: a slow walker's
-estimate dips between scans), it has been MOVE_DISTANCE from where it was first seen
+at least ``moving_speed``, it has been MOVE_DISTANCE from where it was first seen
 at some time (NEW_MOVE_DISTANCE if it was new then: standing on cells the memory
 had seen free; someone walking to and fro stays a mover), and it has left that
 place. How far it went is measured at the scans it is seen (not from predictions);
 it has left the place when fewer than STILL_FRACTION of the points it was first seen
-at (not counting those on the memory's established obstacles: a walker first seen
-against a post) have a return of another cluster within VACATED_RADIUS (or two standard
+at have a return of another cluster within VACATED_RADIUS (or two standard
 deviations of the return's range noise), not counting the returns of tracks that
 moved at the last scan and have gone twice MOVE_DISTANCE (someone walking behind
 another steps where the first was first seen): a piece of a long wall that noise and
@@ -100,9 +98,7 @@ MOVE_DISTANCE = 0.3
 #: this), too late to get out of its way; at this distance for every track, static
 #: clutter seemed to move and the gaps between it closed (docs/moving_obstacles.md).
 NEW_MOVE_DISTANCE = 0.15
-#: Points of a cluster kept from when its track was first seen (those not on the
-#: memory's established obstacles, if it has any: a walker first seen touching a post
-#: has not left its place while the post stands there) ...
+#: Points of a cluster kept from when its track was first seen ...
 FIRST_POINTS = 12
 #: ... and a track moves only once fewer than STILL_FRACTION of them have a return of
 #: another cluster within VACATED_RADIUS [m] (or two standard deviations of that return's
@@ -156,8 +152,6 @@ WALL_FRACTION = 0.5
 #: leaves such cells within a few scans; a person who stood there and walks off, too.
 HELD_UP_FRACTION = 0.5
 STANDING_TIME = 2.0
-#: A track that moved keeps moving down to this fraction of ``moving_speed``.
-KEEP_SPEED_FRACTION = 0.5
 
 
 @dataclass(frozen=True)
@@ -382,7 +376,6 @@ class Tracker:
         self.new_age[seen & (self.new_age >= 0)] += 1
         fresh = [k for k in small if track_of[k] < 0]
         if fresh:
-            on_walls = log_odds_at >= WALL_LOG_ODDS
             m = len(fresh)
             track_of[fresh] = n_tracks + np.arange(m)
             p0 = np.diag([MEASUREMENT_SIGMA ** 2] * 2 + [INITIAL_SPEED_SIGMA ** 2] * 2)
@@ -391,8 +384,7 @@ class Tracker:
                          misses=np.zeros(m, np.int64),
                          new_age=np.where(new[fresh] >= NEW_FRACTION, 0, -1).astype(np.int64),
                          radius=np.zeros(m), ids=self._next_id + np.arange(m),
-                         first=cents[fresh],
-                         first_points=_some_points(points, labels, fresh, ~on_walls),
+                         first=cents[fresh], first_points=_some_points(points, labels, fresh),
                          went=np.zeros(m), seen_at=np.full(m, t),
                          moved=np.zeros(m, bool))
             self._next_id += m
@@ -427,10 +419,7 @@ class Tracker:
         unseen = np.ones(len(self.x), bool)
         unseen[track_of[visible]] = False
         free |= unseen & self.moved
-        # (a track that moved stays moving down to KEEP_SPEED_FRACTION of that speed: a
-        # slow walker's estimated speed dips below it between scans)
-        keep_speed = np.where(self.moved, KEEP_SPEED_FRACTION, 1.0) * self.moving_speed
-        moving = (self.hits >= MIN_HITS) & (speed >= keep_speed) \
+        moving = (self.hits >= MIN_HITS) & (speed >= self.moving_speed) \
             & (self.went >= went) & free
         point_track = track_of[labels] if count else np.zeros(0, np.int64)
         # and it has left where it was first seen: returns there of its own or of another
@@ -465,14 +454,12 @@ def _of_points(point_track: NDArray[np.int64], flags: NDArray[np.bool_]) -> NDAr
 
 
 def _some_points(points: NDArray[np.float64], labels: NDArray[np.int64],
-                 which: list[int], own: NDArray[np.bool_]) -> NDArray[np.float64]:
+                 which: list[int]) -> NDArray[np.float64]:
     """Up to FIRST_POINTS points (k, FIRST_POINTS, 2) [m] of each cluster in ``which``,
-    spread over it in beam order: of its points ``own`` (n,) if it has any, else of
-    all; NaN where a cluster has fewer."""
+    spread over it in beam order; NaN where a cluster has fewer."""
     out = np.full((len(which), FIRST_POINTS, 2), np.nan)
     for row, k in enumerate(which):
-        mine = labels == k
-        mine = points[mine & own] if np.any(mine & own) else points[mine]
+        mine = points[labels == k]
         pick = np.unique(np.linspace(0, len(mine) - 1, FIRST_POINTS).round().astype(int))
         out[row, :len(pick)] = mine[pick]
     return out
